@@ -1,0 +1,11 @@
+//! Shared geometry: planes, 2-D frames on planes, convex polygon clipping, bounding-volume
+//! queries. Geometric *decisions* that must be exact go through `robust` predicates; the
+//! clipping here computes coordinates and is allowed to round.
+
+pub mod bvh;
+pub mod frame;
+pub mod plane;
+pub mod polygon;
+
+pub use frame::Frame;
+pub use plane::Plane;

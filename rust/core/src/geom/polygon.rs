@@ -1,0 +1,190 @@
+//! Convex polygon clipping (Sutherland–Hodgman against one plane or half-plane at a time),
+//! areas, and exact point-in-convex-polygon tests.
+
+use glam::{DVec2, DVec3};
+use robust::{orient2d, Coord};
+
+use super::Plane;
+
+/// Keeps the part of a convex polygon on the non-negative side of `plane`.
+/// Vertices within `eps` of the plane count as on it, so a polygon touching the plane
+/// is not split into slivers.
+pub fn clip_polygon_3d(poly: &[DVec3], plane: &Plane, eps: f64) -> Vec<DVec3> {
+    let n = poly.len();
+    let mut out = Vec::with_capacity(n + 2);
+    if n == 0 {
+        return out;
+    }
+    let d: Vec<f64> = poly.iter().map(|p| plane.dist(*p)).collect();
+    if d.iter().all(|&x| x >= -eps) {
+        return poly.to_vec();
+    }
+    if d.iter().all(|&x| x <= eps) {
+        return out;
+    }
+    for i in 0..n {
+        let j = (i + 1) % n;
+        let (a, b, da, db) = (poly[i], poly[j], d[i], d[j]);
+        if da >= -eps {
+            out.push(a);
+        }
+        if (da > eps && db < -eps) || (da < -eps && db > eps) {
+            let t = da / (da - db);
+            out.push(a + (b - a) * t);
+        }
+    }
+    out
+}
+
+/// A 2-D half-plane `n·x ≥ c` (n need not be unit length).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HalfPlane {
+    pub n: DVec2,
+    pub c: f64,
+}
+
+impl HalfPlane {
+    #[inline]
+    pub fn eval(&self, p: DVec2) -> f64 {
+        self.n.dot(p) - self.c
+    }
+}
+
+/// Keeps the part of a convex 2-D polygon inside `h`. `eps` is in the units of `h.eval`
+/// divided by |n| (i.e. a distance).
+pub fn clip_polygon_2d(poly: &[DVec2], h: &HalfPlane, eps: f64) -> Vec<DVec2> {
+    let n = poly.len();
+    let mut out = Vec::with_capacity(n + 2);
+    if n == 0 {
+        return out;
+    }
+    let inv = 1.0 / h.n.length();
+    let d: Vec<f64> = poly.iter().map(|p| h.eval(*p) * inv).collect();
+    if d.iter().all(|&x| x >= -eps) {
+        return poly.to_vec();
+    }
+    if d.iter().all(|&x| x <= eps) {
+        return out;
+    }
+    for i in 0..n {
+        let j = (i + 1) % n;
+        let (a, b, da, db) = (poly[i], poly[j], d[i], d[j]);
+        if da >= -eps {
+            out.push(a);
+        }
+        if (da > eps && db < -eps) || (da < -eps && db > eps) {
+            let t = da / (da - db);
+            out.push(a + (b - a) * t);
+        }
+    }
+    out
+}
+
+/// Signed area (positive when counter-clockwise).
+pub fn signed_area_2d(poly: &[DVec2]) -> f64 {
+    let n = poly.len();
+    let mut s = 0.0;
+    for i in 0..n {
+        let a = poly[i];
+        let b = poly[(i + 1) % n];
+        s += a.perp_dot(b);
+    }
+    0.5 * s
+}
+
+#[inline]
+pub fn coord(p: DVec2) -> Coord<f64> {
+    Coord { x: p.x, y: p.y }
+}
+
+/// Exact orientation of `c` relative to the directed line `a → b`: > 0 left, < 0 right.
+#[inline]
+pub fn orient(a: DVec2, b: DVec2, c: DVec2) -> f64 {
+    orient2d(coord(a), coord(b), coord(c))
+}
+
+/// Exact test: is `p` strictly inside the counter-clockwise convex polygon `poly`?
+pub fn strictly_inside_convex(poly: &[DVec2], p: DVec2) -> bool {
+    let n = poly.len();
+    if n < 3 {
+        return false;
+    }
+    (0..n).all(|i| orient(poly[i], poly[(i + 1) % n], p) > 0.0)
+}
+
+/// Exact test: is `p` inside or on the boundary of the counter-clockwise convex polygon?
+pub fn inside_convex(poly: &[DVec2], p: DVec2) -> bool {
+    let n = poly.len();
+    if n < 3 {
+        return false;
+    }
+    (0..n).all(|i| orient(poly[i], poly[(i + 1) % n], p) >= 0.0)
+}
+
+/// Removes consecutive duplicates and vertices collinear with their neighbours (exact test),
+/// which clipping leaves behind. Returns fewer than 3 points when nothing with area is left.
+pub fn simplify_convex(poly: &[DVec2]) -> Vec<DVec2> {
+    let mut pts: Vec<DVec2> = Vec::with_capacity(poly.len());
+    for &p in poly {
+        if pts.last() != Some(&p) {
+            pts.push(p);
+        }
+    }
+    while pts.len() > 1 && pts.first() == pts.last() {
+        pts.pop();
+    }
+    let mut changed = true;
+    while changed && pts.len() >= 3 {
+        changed = false;
+        let n = pts.len();
+        for i in 0..n {
+            let a = pts[(i + n - 1) % n];
+            let b = pts[i];
+            let c = pts[(i + 1) % n];
+            if orient(a, b, c) <= 0.0 {
+                pts.remove(i);
+                changed = true;
+                break;
+            }
+        }
+    }
+    pts
+}
+
+#[cfg(test)]
+mod test {
+    use super::*;
+
+    fn square() -> Vec<DVec2> {
+        vec![DVec2::new(0., 0.), DVec2::new(1., 0.), DVec2::new(1., 1.), DVec2::new(0., 1.)]
+    }
+
+    #[test]
+    fn clip_square_in_half() {
+        let h = HalfPlane { n: DVec2::new(1.0, 0.0), c: 0.5 };
+        let r = clip_polygon_2d(&square(), &h, 0.0);
+        assert!((signed_area_2d(&r) - 0.5).abs() < 1e-15);
+    }
+
+    #[test]
+    fn clip_3d_keeps_positive_side() {
+        let tri = [DVec3::new(0., 0., -1.), DVec3::new(1., 0., 1.), DVec3::new(0., 1., 1.)];
+        let r = clip_polygon_3d(&tri, &Plane::new(DVec3::Z, 0.0), 0.0);
+        assert!(r.iter().all(|p| p.z >= -1e-15));
+        assert_eq!(r.len(), 4);
+    }
+
+    #[test]
+    fn inside_tests_are_exact_on_boundary() {
+        let s = square();
+        assert!(inside_convex(&s, DVec2::new(1.0, 0.5)));
+        assert!(!strictly_inside_convex(&s, DVec2::new(1.0, 0.5)));
+        assert!(strictly_inside_convex(&s, DVec2::new(0.5, 0.5)));
+    }
+
+    #[test]
+    fn simplify_drops_collinear() {
+        let p = vec![DVec2::new(0., 0.), DVec2::new(0.5, 0.), DVec2::new(1., 0.), DVec2::new(1., 1.), DVec2::new(1., 1.)];
+        assert_eq!(simplify_convex(&p).len(), 3);
+    }
+}

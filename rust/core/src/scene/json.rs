@@ -1,0 +1,127 @@
+//! Scene JSON v1 as serde types: the public interchange format (README documents it).
+//! Parsing only; every check of values is in `validate`.
+
+use serde::{Deserialize, Serialize};
+
+pub const SCENE_FORMAT: &str = "penumbra-scene";
+pub const SCENE_VERSION: u32 = 1;
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneJson {
+    pub format: String,
+    pub version: u32,
+    #[serde(default)]
+    pub meshes: Vec<MeshJson>,
+    #[serde(default)]
+    pub lights: Vec<LightJson>,
+    #[serde(default)]
+    pub settings: SettingsJson,
+}
+
+/// One colour per polygon, or one colour for the whole mesh.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum PerPolygon {
+    Uniform([f64; 3]),
+    PerPolygon(Vec<[f64; 3]>),
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshJson {
+    pub name: String,
+    pub positions: Vec<[f64; 3]>,
+    pub polygons: Vec<Vec<i64>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub albedo: Option<PerPolygon>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub emission: Option<PerPolygon>,
+}
+
+/// A light: exactly one of `polygon` (area light, with `radiance`), `point` (with
+/// `intensity`, optionally a `spot` cone) or `direction` (sun, with `irradiance`).
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightJson {
+    pub name: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub polygon: Option<Vec<[f64; 3]>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radiance: Option<[f64; 3]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub point: Option<[f64; 3]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub intensity: Option<[f64; 3]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spot: Option<SpotJson>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub direction: Option<[f64; 3]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub irradiance: Option<[f64; 3]>,
+}
+
+/// A spot cone as Blender has it: the light points along `direction`; `angle` is the full
+/// cone angle in radians, `blend` the soft edge fraction in [0, 1].
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpotJson {
+    pub direction: [f64; 3],
+    pub angle: f64,
+    #[serde(default)]
+    pub blend: f64,
+}
+
+/// All optional; `validate` fills defaults relative to the scene's size.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SettingsJson {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub element_size: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub penumbra_element_size: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub patch_size: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_angle: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_elements: Option<u64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub indirect: Option<bool>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub convergence: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_shots: Option<u64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ambient: Option<bool>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lighting_only: Option<bool>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub penumbra_visibility: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub penumbra_samples: Option<u32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub visibility_rays: Option<u32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub threads: Option<u32>,
+}
+
+impl SceneJson {
+    /// Parses scene JSON text and checks `format` and `version`.
+    pub fn from_str(text: &str) -> Result<Self, crate::BakeError> {
+        let s: SceneJson = serde_json::from_str(text).map_err(|e| crate::BakeError::Format(e.to_string()))?;
+        if s.format != SCENE_FORMAT {
+            return Err(crate::BakeError::Format(format!(
+                "format is {:?}, expected {SCENE_FORMAT:?}",
+                s.format
+            )));
+        }
+        if s.version != SCENE_VERSION {
+            return Err(crate::BakeError::Format(format!(
+                "version {} is not supported (this build reads version {SCENE_VERSION})",
+                s.version
+            )));
+        }
+        Ok(s)
+    }
+}
