@@ -5,9 +5,11 @@
 //! → `mesh` → `direct` → `indirect` → `bake` (output).
 
 pub mod bake;
+pub mod elements;
 pub mod error;
 pub mod geom;
 pub mod progress;
+pub mod relation;
 pub mod scene;
 pub mod settings;
 

@@ -1,0 +1,32 @@
+//! The element mesh of the whole scene after meshing: what lighting works on.
+//! Vertices belong to exactly one receiver face (no sharing across faces), so each has one
+//! normal; the output step welds coplanar neighbours afterwards.
+
+use glam::DVec3;
+
+use crate::relation::Relation;
+
+#[derive(Debug, Clone, Default)]
+pub struct Elements {
+    pub positions: Vec<DVec3>,
+    /// Unit normal of the vertex's receiver face (its front).
+    pub normals: Vec<DVec3>,
+    /// Receiver face (index into `Scene::faces`) of each vertex.
+    pub vertex_face: Vec<u32>,
+    pub triangles: Vec<[u32; 3]>,
+    /// Receiver face of each triangle.
+    pub tri_face: Vec<u32>,
+    /// Region (index into `regions`) of each triangle.
+    pub tri_region: Vec<u32>,
+    pub regions: Vec<Region>,
+}
+
+/// A face after the loop split: one relation per light, and for each light the occluder faces
+/// whose penumbra volume contains the region (the only ones that can hide part of that light
+/// from a point of the region).
+#[derive(Debug, Clone, Default)]
+pub struct Region {
+    pub face: u32,
+    pub relations: Vec<Relation>,
+    pub blockers: Vec<Vec<u32>>,
+}
