@@ -4,6 +4,7 @@
 //! The pipeline runs one direction: `scene` → `shadow` → `edges` → `arrangement`/`relation`
 //! → `mesh` → `direct` → `indirect` → `bake` (output).
 
+pub mod arrangement;
 pub mod bake;
 pub mod elements;
 pub mod error;
