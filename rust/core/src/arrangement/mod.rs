@@ -38,6 +38,11 @@ pub struct Segment {
     pub tag: u32,
 }
 
+/// Largest coordinate magnitude accepted.
+pub const MAX_COORD: f64 = 1e100;
+/// Smallest receiver diameter accepted.
+pub const MIN_DIAMETER: f64 = 1e-100;
+
 /// Tag of the edges that lie on the receiver boundary.
 pub const BOUNDARY_TAG: u32 = u32::MAX;
 
@@ -111,11 +116,13 @@ impl Arrangement {
 /// `segments`: discontinuity edges, already clipped to the boundary (endpoints inside or on
 /// it, up to rounding; what lies farther than `snap` outside is clipped away). They may
 /// cross each other, touch, overlap collinearly, coincide with the boundary, be zero-length
-/// (dropped) or dangle. A segment with a non-finite coordinate is dropped.
+/// (dropped) or dangle. A segment with a coordinate that is not finite or beyond
+/// [`MAX_COORD`] is dropped.
 /// `snap`: distance below which two points are the same vertex (the caller passes ~1e-9 ×
 /// the receiver's diameter).
 ///
-/// Returns an empty arrangement when the boundary has a non-finite coordinate or no area.
+/// Returns an empty arrangement when the boundary has a non-finite coordinate, no area, a
+/// coordinate beyond [`MAX_COORD`] or a diameter below [`MIN_DIAMETER`].
 ///
 /// ```
 /// use glam::DVec2;
@@ -138,6 +145,14 @@ pub fn build(boundary: &[DVec2], segments: &[Segment], snap: f64) -> Arrangement
     let extent = boundary
         .iter()
         .fold(0.0f64, |m, p| m.max(p.x.abs()).max(p.y.abs()));
+    let diameter = boundary
+        .iter()
+        .fold(0.0f64, |m, p| m.max((*p - boundary[0]).length()));
+    // Beyond these, products of coordinate differences overflow or underflow and the exact
+    // predicates lose their guarantee.
+    if extent > MAX_COORD || diameter < MIN_DIAMETER {
+        return Arrangement::default();
+    }
     let mut pool = snap::VertexPool::new(snap, extent);
 
     let mut raw: Vec<split::Edge> = Vec::with_capacity(boundary.len() + segments.len());
@@ -206,7 +221,8 @@ fn clean_boundary(boundary: &[DVec2]) -> Option<Vec<DVec2>> {
 /// `snap` outside (so a segment lying on the boundary up to rounding survives and snaps
 /// onto it). `None` when nothing is left or a coordinate is not finite.
 fn clip_to_convex(poly: &[DVec2], a: DVec2, b: DVec2, snap: f64) -> Option<(DVec2, DVec2)> {
-    if !a.is_finite() || !b.is_finite() {
+    let sane = |p: DVec2| p.is_finite() && p.abs().max_element() <= MAX_COORD;
+    if !sane(a) || !sane(b) {
         return None;
     }
     let (mut t0, mut t1) = (0.0f64, 1.0f64);
@@ -235,7 +251,8 @@ fn clip_to_convex(poly: &[DVec2], a: DVec2, b: DVec2, snap: f64) -> Option<(DVec
     }
     let pa = if t0 > 0.0 { a + (b - a) * t0 } else { a };
     let pb = if t1 < 1.0 { a + (b - a) * t1 } else { b };
-    Some((onto_boundary(poly, pa), onto_boundary(poly, pb)))
+    let (pa, pb) = (onto_boundary(poly, pa), onto_boundary(poly, pb));
+    (pa.is_finite() && pb.is_finite()).then_some((pa, pb))
 }
 
 /// A point left a hair outside the boundary, moved onto it: otherwise the boundary edge

@@ -430,6 +430,14 @@ fn bad_input_does_not_panic() {
         assert_eq!(arr.faces[0].area, 16.0);
         assert_eq!(arr.edges.len(), 4);
     }
+    let huge = [seg(1e300, 2., 2., 2., 0), seg(-1e200, 1., 1e200, 1., 1)];
+    assert_eq!(build(&b, &huge, 1e-9).faces.len(), 1);
+    assert!(build(&rect(0., 0., 1e101, 1e101), &[], 1.0)
+        .faces
+        .is_empty());
+    assert!(build(&rect(0., 0., 1e-101, 1e-101), &[], 0.0)
+        .faces
+        .is_empty());
     // Clockwise boundary is accepted.
     let mut cw = b.clone();
     cw.reverse();

@@ -46,6 +46,21 @@ fn angle_cmp(c: DVec2, p: DVec2, q: DVec2) -> Ordering {
     })
 }
 
+/// A number in [0, 4) increasing with the angle of `d` from the +x axis, like `atan2`
+/// but cheaper; only used as a first guess before the exact order.
+fn pseudo_angle(d: DVec2) -> f64 {
+    let s = d.x.abs() + d.y.abs();
+    if !(s > 0.0) {
+        return 0.0;
+    }
+    let r = d.x / s;
+    if d.y >= 0.0 {
+        1.0 - r
+    } else {
+        3.0 + r
+    }
+}
+
 #[derive(Clone, Copy, PartialEq, Debug)]
 enum Kind {
     /// Counter-clockwise: the outer loop of a bounded face.
@@ -155,14 +170,18 @@ fn trace_loops(pts: &[DVec2], edges: &[ArrEdge]) -> Vec<Loop> {
     let mut slot = vec![0u32; nh];
     for (v, hs) in around.iter_mut().enumerate() {
         let c = pts[v];
-        hs.sort_by(|&x, &y| {
-            angle_cmp(
-                c,
-                pts[dest(edges, x) as usize],
-                pts[dest(edges, y) as usize],
-            )
-            .then(x.cmp(&y))
-        });
+        let to = |h: u32| pts[dest(edges, h) as usize];
+        // A rounded key sorts nearly right, and insertion with the exact comparison then
+        // fixes the neighbours rounding swapped. Insertion (unlike `sort_by`) cannot panic
+        // should a degenerate input ever make the comparison inconsistent.
+        hs.sort_by(|&x, &y| pseudo_angle(to(x) - c).total_cmp(&pseudo_angle(to(y) - c)));
+        for i in 1..hs.len() {
+            let mut j = i;
+            while j > 0 && angle_cmp(c, to(hs[j - 1]), to(hs[j])) == Ordering::Greater {
+                hs.swap(j - 1, j);
+                j -= 1;
+            }
+        }
         for (i, &h) in hs.iter().enumerate() {
             slot[h as usize] = i as u32;
         }
