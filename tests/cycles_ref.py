@@ -110,12 +110,15 @@ def add_light(kind: str, location=(0.0, 0.0, 2.0), rotation=(0.0, 0.0, 0.0),
 
 
 def bake_vertex_colors(obj, lighting_only: bool = False, samples: int | None = None,
-                       seed: int | None = None):
-    """Cycles Diffuse bake of ``obj`` into a float colour attribute on its vertices.
+                       seed: int | None = None, bake_type: str = "DIFFUSE",
+                       pass_filter: set | None = None):
+    """Cycles bake of ``obj`` into a float colour attribute on its vertices.
 
-    ``pass_filter`` is {DIRECT, INDIRECT, COLOR}, or {DIRECT, INDIRECT} when
-    ``lighting_only`` (Cycles then gives irradiance / pi). Returns (positions (V,3) in world
-    space, colours (V,3) linear RGB).
+    By default a Diffuse bake with ``pass_filter`` {DIRECT, INDIRECT, COLOR}, or
+    {DIRECT, INDIRECT} when ``lighting_only`` (Cycles then gives irradiance / pi); other
+    ``bake_type`` / ``pass_filter`` values are passed through (e.g. {COLOR} alone gives the
+    diffuse albedo, EMIT the emitted radiance). Returns (positions (V,3) in world space,
+    colours (V,3) linear RGB).
     """
     import bpy
 
@@ -133,8 +136,9 @@ def bake_vertex_colors(obj, lighting_only: bool = False, samples: int | None = N
         o.select_set(False)
     obj.select_set(True)
     bpy.context.view_layer.objects.active = obj
-    passes = {"DIRECT", "INDIRECT"} if lighting_only else {"DIRECT", "INDIRECT", "COLOR"}
-    res = bpy.ops.object.bake(type="DIFFUSE", pass_filter=passes, target="VERTEX_COLORS",
+    if pass_filter is None:
+        pass_filter = {"DIRECT", "INDIRECT"} if lighting_only else {"DIRECT", "INDIRECT", "COLOR"}
+    res = bpy.ops.object.bake(type=bake_type, pass_filter=pass_filter, target="VERTEX_COLORS",
                               use_clear=True, margin=0)
     if res != {"FINISHED"}:
         raise RuntimeError(f"Cycles bake failed: {res}")
