@@ -20,8 +20,11 @@ surface normal, which is the direction a bake looks from). Measured with bpy 5.0
     default Principled (0.8 base, roughness 0.5, IOR 1.5) gives 0.770, not 0.8.
   - coat = (1 − w·E_spec(Coat Roughness, F0(Coat IOR))) · (1 − w + w·Coat Tint), w = Coat
     Weight (the tint is crossed once along the normal).
-  - Specular Tint, Sheen (< 0.1 %), Subsurface Weight (subsurface counts as diffuse),
-    Diffuse Roughness do not change the colour.
+  - sheen sits on top of everything and counts as diffuse colour itself:
+    albedo ← (1 − s·E_sheen(Sheen Roughness)) · albedo + s·E_sheen · Sheen Tint, s = Sheen
+    Weight, E_sheen measured likewise (0 for roughness ≤ 0.2, 0.019 at 0.5, 0.34 at 1).
+  - Specular Tint, Subsurface Weight (subsurface counts as diffuse) and Diffuse Roughness
+    do not change the colour.
 * Emission shader: emission = Color · Strength (radiance, W·sr⁻¹·m⁻², what Cycles' Emit bake
   gives); albedo 0. Principled: emission = Emission Color · Emission Strength.
 * Mix Shader: (1 − Fac) · A + Fac · B; Add Shader: A + B (both for albedo and emission).
@@ -41,7 +44,7 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["polygon_colors", "material_colors", "principled_diffuse_albedo",
-           "specular_layer_albedo", "DEFAULT_ALBEDO"]
+           "specular_layer_albedo", "sheen_layer_albedo", "DEFAULT_ALBEDO"]
 
 # g(r, F0) = E_spec / F0: the normal-incidence albedo of Cycles' dielectric specular layer
 # over F0, at Principled roughness r = 0, 0.1, ..., 1 (rows) for F0 = 0.04, 1/9, 0.25
@@ -54,6 +57,16 @@ _G_TABLE = np.array([
     [1.0, 0.99993, 0.99874, 0.99309, 0.97517, 0.93311, 0.85575, 0.74333, 0.61086, 0.47896, 0.36334],
     [1.0, 0.99993, 0.99878, 0.99332, 0.97665, 0.93806, 0.86768, 0.76502, 0.64220, 0.51704, 0.40388],
 ])
+
+# Normal-incidence albedo of the sheen layer at Sheen Roughness 0, 0.1, ..., 1, measured
+# likewise (black base, white tint, Sheen Weight 1: the colour is E_sheen itself).
+_SHEEN_E = np.array([0.0, 0.0, 7.4e-05, 0.000796, 0.004892, 0.018645, 0.05043, 0.104127,
+                     0.175888, 0.257708, 0.34187])
+
+
+def sheen_layer_albedo(roughness: float) -> float:
+    """Albedo, seen from the normal, of Cycles' Principled sheen layer (see ``_SHEEN_E``)."""
+    return float(np.interp(float(np.clip(roughness, 0.0, 1.0)), _G_ROUGHNESS, _SHEEN_E))
 
 
 def specular_layer_albedo(roughness: float, f0: float) -> float:
@@ -73,7 +86,8 @@ def _f0_from_ior(ior: float) -> float:
 
 def principled_diffuse_albedo(base_color, metallic=0.0, transmission=0.0, roughness=0.5,
                               ior=1.5, specular_ior_level=0.5, alpha=1.0, coat_weight=0.0,
-                              coat_roughness=0.03, coat_ior=1.5, coat_tint=(1.0, 1.0, 1.0)):
+                              coat_roughness=0.03, coat_ior=1.5, coat_tint=(1.0, 1.0, 1.0),
+                              sheen_weight=0.0, sheen_roughness=0.5, sheen_tint=(1.0, 1.0, 1.0)):
     """The diffuse colour Cycles bakes for a Principled BSDF (see the module docstring)."""
     base = np.asarray(base_color, dtype=np.float64)[:3]
     m = float(np.clip(metallic, 0.0, 1.0))
@@ -86,6 +100,9 @@ def principled_diffuse_albedo(base_color, metallic=0.0, transmission=0.0, roughn
         e_coat = specular_layer_albedo(coat_roughness, _f0_from_ior(coat_ior))
         tint = np.asarray(coat_tint, dtype=np.float64)[:3]
         albedo = albedo * (1.0 - w * e_coat) * (1.0 - w + w * tint)
+    s = float(np.clip(sheen_weight, 0.0, 1.0)) * sheen_layer_albedo(sheen_roughness)
+    if s > 0.0:
+        albedo = (1.0 - s) * albedo + s * np.asarray(sheen_tint, dtype=np.float64)[:3]
     return albedo
 
 
@@ -212,7 +229,9 @@ def _closure(sock, warn, where, depth=0):
             transmission=f("Transmission Weight"), roughness=f("Roughness"), ior=f("IOR"),
             specular_ior_level=f("Specular IOR Level"), alpha=f("Alpha"),
             coat_weight=f("Coat Weight"), coat_roughness=f("Coat Roughness"),
-            coat_ior=f("Coat IOR"), coat_tint=_rgb(inp["Coat Tint"], warn, where))
+            coat_ior=f("Coat IOR"), coat_tint=_rgb(inp["Coat Tint"], warn, where),
+            sheen_weight=f("Sheen Weight"), sheen_roughness=f("Sheen Roughness"),
+            sheen_tint=_rgb(inp["Sheen Tint"], warn, where))
         emission = _rgb(inp["Emission Color"], warn, where) * f("Emission Strength")
         return albedo, emission
     if t == "ShaderNodeMixShader":
@@ -241,7 +260,9 @@ def material_colors(material, warnings: list | None = None):
     where = f"material '{material.name}'"
     nt = material.node_tree
     if nt is None:
-        # A material without nodes renders in Cycles as a diffuse of its viewport colour.
+        # No node tree: Cycles renders a Diffuse BSDF of the viewport colour
+        # (intern/cycles/blender/shader.cpp, BlenderSync::sync_materials). Blender 5.0 ignores
+        # use_nodes = False (measured: the node tree is still used), so we ignore it too.
         return np.array(material.diffuse_color[:3], dtype=np.float64), np.zeros(3)
     outs = [n for n in nt.nodes if n.bl_idname == "ShaderNodeOutputMaterial"
             and getattr(n, "target", "ALL") in {"ALL", "CYCLES"}]
