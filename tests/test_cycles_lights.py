@@ -260,3 +260,13 @@ def test_portal_and_zero_energy_export_nothing():
     p.data.cycles.is_portal = True
     z = cr.add_light("POINT", energy=0.0)
     assert lights_to_scene(p) == [] and lights_to_scene(z) == []
+
+
+def test_light_linking_is_unsupported():
+    cr.new_scene(samples=1)
+    lo = cr.add_light("AREA", energy=10.0)
+    coll = bpy.data.collections.new("Receivers")
+    bpy.context.scene.collection.children.link(coll)
+    lo.light_linking.receiver_collection = coll
+    with pytest.raises(UnsupportedLightError, match="light_linking"):
+        lights_to_scene(lo)

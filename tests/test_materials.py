@@ -258,3 +258,37 @@ def test_large_mesh_is_vectorised():
     dt = time.perf_counter() - t
     assert np.array_equal(np.argmax(a, axis=1), idx)
     assert dt < 1.0, f"{dt:.2f} s for {len(me.polygons)} polygons"
+
+
+@pytest.mark.parametrize("facing", ["down", "up"])
+def test_emissive_mesh_lights_like_a_polygon_of_that_radiance(facing):
+    """An emissive quad of emission colour·strength C lights a receiver exactly like a
+    polygon light of radiance C (Lambert's formula) — so ``emission`` is the radiance the
+    radiosity must shoot. Cycles' mesh emission is two-sided: flipping the quad (facing up,
+    away from the receiver) changes nothing."""
+    cr.new_scene(samples=1024)
+    plane = cr.add_grid(24, 4.0, material=cr.diffuse_material())
+    m = bpy.data.materials.new("Glow")
+    nt = m.node_tree
+    nt.nodes.clear()
+    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    em = nt.nodes.new("ShaderNodeEmission")
+    em.inputs["Color"].default_value = (1.0, 0.6, 0.3, 1.0)
+    em.inputs["Strength"].default_value = 5.0
+    nt.links.new(em.outputs["Emission"], out.inputs["Surface"])
+    quad = [(-0.5, -0.5, 0.0), (0.5, -0.5, 0.0), (0.5, 0.5, 0.0), (-0.5, 0.5, 0.0)]
+    face = [(0, 3, 2, 1)] if facing == "down" else [(0, 1, 2, 3)]
+    me = bpy.data.meshes.new("Lamp")
+    me.from_pydata(quad, [], face)
+    me.materials.append(m)
+    lamp = bpy.data.objects.new("Lamp", me)
+    lamp.location = (0.3, -0.2, 1.5)
+    bpy.context.scene.collection.objects.link(lamp)
+    bpy.context.view_layer.update()
+    _, e = polygon_colors(lamp, me)
+    pos, baked = cr.bake_vertex_colors(plane)
+    poly = (np.array(quad) + np.array(lamp.location))[[0, 3, 2, 1]]  # front facing down
+    ours = cr.outgoing_radiance(pos, (0, 0, 1), [{"polygon": poly, "radiance": e[0]}])
+    r, err = cr.ratio(ours, baked), cr.relative_rms(ours, baked)
+    print(f"\n[materials] emissive quad facing {facing}: ours/Cycles = {r:.5f}  relative RMS = {err:.5f}")
+    assert err <= 0.01

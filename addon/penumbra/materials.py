@@ -26,7 +26,10 @@ surface normal, which is the direction a bake looks from). Measured with bpy 5.0
   - Specular Tint, Subsurface Weight (subsurface counts as diffuse) and Diffuse Roughness
     do not change the colour.
 * Emission shader: emission = Color · Strength (radiance, W·sr⁻¹·m⁻², what Cycles' Emit bake
-  gives); albedo 0. Principled: emission = Emission Color · Emission Strength.
+  gives, and what lights other surfaces: an emissive quad lights a receiver exactly like a
+  polygon light of that radiance — tested); albedo 0. Principled: emission = Emission Color ·
+  Emission Strength. NOTE: Cycles' mesh emission is two-sided (tested: flipping the quad
+  changes nothing), unlike the one-sided light polygons of the scene JSON.
 * Mix Shader: (1 − Fac) · A + Fac · B; Add Shader: A + B (both for albedo and emission).
 * Other BSDFs (Glossy, Glass, Refraction, Translucent, Transparent, Toon, Sheen, hair,
   Metallic): no diffuse closure → albedo 0. Subsurface Scattering: albedo = Color.
