@@ -42,9 +42,12 @@ Shapes and orientation
 Approximations (documented, not errors)
     * POINT/SPOT ``shadow_soft_size`` (radius) r > 0: exported as a point of the same
       intensity. With ``use_soft_falloff`` off Cycles uses a sphere light, whose irradiance on an
-      unoccluded receiver that sees the whole sphere is exactly I·cos/d²; with soft falloff (the
-      default) Cycles uses a disk facing the receiver: relative difference ≈ r²/d². Shadows
-      are hard (a point) either way.
+      unoccluded receiver that sees the whole sphere is exactly I·cos/d² (tested); with soft
+      falloff (the default) Cycles uses a disk of radius r facing the receiver
+      (kernel/light/point.h), which gives exactly I·cos/(d² + r²) (tested), so our point is
+      too bright by r²/d² (0.25 % for r = 0.1 at 2 m; 1.5 % for r = 0.3). A scene-JSON
+      ``radius`` for point lights would make this exact. Shadows are hard (a point) either
+      way. Spots with a radius are approximated the same way (untested).
     * SUN ``angle``: exported as an exact direction. Unoccluded receivers get exactly E⊥·cos
       while the sun disk is entirely above their horizon; shadows are hard.
     * ``diffuse_factor`` (and the other influence factors) are EEVEE-only: Cycles ignores them
