@@ -5,6 +5,7 @@
 //! → `mesh` → `direct` → `indirect` → `bake` (output).
 
 pub mod bake;
+pub mod direct;
 pub mod elements;
 pub mod error;
 pub mod geom;

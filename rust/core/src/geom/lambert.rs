@@ -107,7 +107,7 @@ fn edge_term(n: DVec3, a: DVec3, e: DVec3, b: DVec3) -> f64 {
 }
 
 #[cfg(test)]
-mod test {
+pub(crate) mod test {
     use super::*;
     use std::f64::consts::PI;
 
