@@ -27,6 +27,9 @@
 //! (≈ 1e-13 for a light 1e-3 of its distance). Callers that want this bound should pass
 //! coordinates whose origin is near the polygon, not near `p`.
 
+// `!(x > 0.0)` is meant: NaN must take the "nothing here" branch.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use glam::DVec3;
 
 use super::polygon::clip_polygon_3d;
