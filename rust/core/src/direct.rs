@@ -590,18 +590,32 @@ mod test {
     }
 
     #[test]
-    fn scale_invariance() {
+    fn scale_and_translation_invariance() {
         let p = DVec3::new(0.6, 0.2, 0.0);
         let tilted = DVec3::new(0.3, -0.2, 1.0).normalize();
         let scene = [(LIGHT, 2.0, true), (OCC, 1.0, false), (OCC2, 1.5, true)];
-        let run = |s: f64, k: usize| {
-            let [l, o1, o2] = scene.map(|(r, z, down)| rect(r.map(|x| x * s), z * s, down));
+        let run = |s: f64, t: DVec3, k: usize| {
+            let place = |(r, z, down): (Rect, f64, bool)| {
+                rect(r, z, down)
+                    .iter()
+                    .map(|v| *v * s + t)
+                    .collect::<Vec<_>>()
+            };
+            let [l, o1, o2] = scene.map(place);
             let b = [o1.as_slice(), &o2];
-            eval_with(&l, p * s, tilted, Penumbra, &b[..k], Exact, 0)
+            eval_with(&l, p * s + t, tilted, Penumbra, &b[..k], Exact, 0)
         };
+        // Far from the world origin (1e3 times the scene's size) only the position's own
+        // rounding (1e-16 of it) is lost, as the work is done relative to the light.
+        let far = DVec3::new(1e3, -2e3, 5e2);
         for k in [1, 2] {
+            let e1 = run(1.0, DVec3::ZERO, k);
             for s in [1e-3, 1e4] {
-                assert!(rel_err(run(s, k), run(1.0, k)) < 1e-9, "scale {s}, {k}");
+                assert!(rel_err(run(s, DVec3::ZERO, k), e1) < 1e-9, "scale {s}, {k}");
+                assert!(
+                    rel_err(run(s, far * s, k), e1) < 1e-9,
+                    "moved, scale {s}, {k}"
+                );
             }
         }
     }
