@@ -54,14 +54,20 @@ pub const TOUCH: f64 = 1e-10;
 /// use glam::DVec3;
 /// use penumbra::direct::area_light;
 /// use penumbra::geom::Plane;
-/// use penumbra::relation::Relation;
-/// use penumbra::settings::PenumbraVisibility;
-/// // A 2×2 light at height 1 facing down, an occluder hiding exactly its x < 0 half.
-/// let light = [DVec3::new(-1., -1., 1.), DVec3::new(-1., 1., 1.), DVec3::new(1., 1., 1.), DVec3::new(1., -1., 1.)];
+/// use penumbra::relation::Relation::{Lit, Penumbra};
+/// use penumbra::settings::PenumbraVisibility::Exact;
+/// let quad = |x0: f64, x1: f64, y0: f64, y1: f64, z: f64| {
+///     [(x0, y0), (x1, y0), (x1, y1), (x0, y1)].map(|(x, y)| DVec3::new(x, y, z))
+/// };
+/// // A 2×2 light at height 1 facing down (wound clockwise seen from above), and an
+/// // occluder halfway up that hides exactly its x < 0 half from the origin.
+/// let mut light = quad(-1.0, 1.0, -1.0, 1.0, 1.0);
+/// light.reverse();
 /// let plane = Plane::from_polygon(&light).unwrap();
-/// let half = [DVec3::new(-2., -2., 0.5), DVec3::new(0., -2., 0.5), DVec3::new(0., 2., 0.5), DVec3::new(-2., 2., 0.5)];
-/// let lit = area_light(DVec3::ZERO, DVec3::Z, &light, &plane, DVec3::ONE, Relation::Lit, &[], PenumbraVisibility::Exact, 0);
-/// let pen = area_light(DVec3::ZERO, DVec3::Z, &light, &plane, DVec3::ONE, Relation::Penumbra, &[&half], PenumbraVisibility::Exact, 0);
+/// let half = quad(-2.0, 0.0, -2.0, 2.0, 0.5);
+/// let (p, n, white) = (DVec3::ZERO, DVec3::Z, DVec3::ONE);
+/// let lit = area_light(p, n, &light, &plane, white, Lit, &[], Exact, 0);
+/// let pen = area_light(p, n, &light, &plane, white, Penumbra, &[&half], Exact, 0);
 /// assert!((pen.x - 0.5 * lit.x).abs() < 1e-12);
 /// ```
 #[allow(clippy::too_many_arguments)]
@@ -121,7 +127,7 @@ struct View<'a> {
 impl View<'_> {
     /// Irradiance per unit radiance from the visible part of the light.
     fn exact_visible(&self, blockers: &[Vec<DVec3>], unoccluded: f64) -> f64 {
-        let View { q, n, light, ln } = *self;
+        let View { q, n, light, .. } = *self;
         let reach = light.iter().map(|l| (*l - q).length()).fold(0.0, f64::max);
         let hidden: Vec<Vec<DVec3>> = blockers
             .iter()
@@ -131,42 +137,36 @@ impl View<'_> {
             0 => unoccluded,
             // One hidden part lies inside the light, so the visible integral is a difference.
             1 => (unoccluded - polygon_irradiance(q, n, &hidden[0])).clamp(0.0, unoccluded),
-            _ => {
-                let frame = Frame::new(DVec3::ZERO, ln);
-                let to2 = |v: &DVec3| -> [f64; 2] {
-                    let t = frame.to_2d(*v);
-                    [t.x, t.y]
-                };
-                let subj: Vec<[f64; 2]> = light.iter().map(to2).collect();
-                let clip: Vec<Vec<[f64; 2]>> = hidden
-                    .iter()
-                    .filter_map(|h| {
-                        let mut c: Vec<[f64; 2]> = h.iter().map(to2).collect();
-                        let a =
-                            signed_area_2d(&c.iter().map(|x| DVec2::from(*x)).collect::<Vec<_>>());
-                        // Under the non-zero rule a clockwise part would cancel a counter-clockwise
-                        // one where they overlap instead of adding to the union.
-                        if !(a.abs() > 0.0) {
-                            return None;
-                        }
-                        if a < 0.0 {
-                            c.reverse();
-                        }
-                        Some(c)
-                    })
-                    .collect();
-                // The i64 grid resolves 2^-60 of the light's extent: far below f64 rounding of the
-                // integral, so the boolean adds no visible error.
-                let shapes = FloatOverlay::<[f64; 2], i64>::from_subj_and_clip(&subj, &clip)
-                    .overlay(OverlayRule::Difference, FillRule::NonZero);
-                let contours: Vec<Vec<DVec3>> = shapes
-                    .iter()
-                    .flatten()
-                    .map(|c| c.iter().map(|x| frame.to_3d(DVec2::from(*x))).collect())
-                    .collect();
-                contours_irradiance(q, n, &contours).min(unoccluded)
-            }
+            _ => self.light_minus_union(&hidden).min(unoccluded),
         }
+    }
+
+    /// Irradiance per unit radiance from the light minus the union of several hidden parts,
+    /// by a polygon boolean in the light's plane.
+    fn light_minus_union(&self, hidden: &[Vec<DVec3>]) -> f64 {
+        let frame = Frame::new(DVec3::ZERO, self.ln);
+        let to2 = |v: &DVec3| frame.to_2d(*v).to_array();
+        let subj: Vec<[f64; 2]> = self.light.iter().map(to2).collect();
+        let clip: Vec<Vec<[f64; 2]>> = hidden
+            .iter()
+            .filter_map(|h| {
+                let mut c: Vec<[f64; 2]> = h.iter().map(to2).collect();
+                let a = signed_area_2d(&c.iter().map(|x| DVec2::from(*x)).collect::<Vec<_>>());
+                // Under the non-zero rule a clockwise part would cancel a counter-clockwise
+                // one where they overlap instead of adding to the union.
+                if a < 0.0 {
+                    c.reverse();
+                }
+                (a.abs() > 0.0).then_some(c)
+            })
+            .collect();
+        // The i64 grid resolves 2^-60 of the light's extent, far below the f64 rounding of
+        // the integral, so the boolean adds no visible error.
+        let shapes = FloatOverlay::<[f64; 2], i64>::from_subj_and_clip(&subj, &clip)
+            .overlay(OverlayRule::Difference, FillRule::NonZero);
+        let lift = |c: &Vec<[f64; 2]>| c.iter().map(|x| frame.to_3d(DVec2::from(*x))).collect();
+        let contours: Vec<Vec<DVec3>> = shapes.iter().flatten().map(lift).collect();
+        contours_irradiance(self.q, self.n, &contours)
     }
 
     /// The part of the light that convex occluder `o` hides from `q`, or `None` when nothing with
@@ -197,8 +197,8 @@ impl View<'_> {
                 return None;
             }
             let (a, b) = (o[i] - q, o[(i + 1) % o.len()] - q);
-            // With O counter-clockwise about `no`, its inside is where (a × b)·(x − q) has the sign
-            // of −h; the sign of h turns this around for an occluder facing away from q.
+            // With O counter-clockwise about `no`, its inside is where (a × b)·(x − q) has
+            // the sign of −h; the sign of h turns this around for an occluder facing away.
             let m = (-s * a.cross(b)).normalize_or_zero();
             if m == DVec3::ZERO {
                 return None;

@@ -44,7 +44,7 @@ use super::Plane;
 /// use penumbra::geom::lambert::polygon_irradiance;
 /// // A huge square far above the point covers nearly the whole hemisphere: E → π.
 /// let s = 1e6;
-/// let sq = [DVec3::new(-s, -s, 1.0), DVec3::new(s, -s, 1.0), DVec3::new(s, s, 1.0), DVec3::new(-s, s, 1.0)];
+/// let sq = [(-s, -s), (s, -s), (s, s), (-s, s)].map(|(x, y)| DVec3::new(x, y, 1.0));
 /// let e = polygon_irradiance(DVec3::ZERO, DVec3::Z, &sq);
 /// assert!((e - std::f64::consts::PI).abs() < 1e-5);
 /// ```
