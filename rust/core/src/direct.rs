@@ -324,8 +324,12 @@ pub fn point_light(
 }
 
 /// Blender Cycles' spot cone mask for light travelling along `to_point` (from the light to
-/// the receiver, any length). Cycles 4.x/5.x (`intern/cycles/kernel/light/spot.h`,
-/// `spot_light_attenuation`; constants from `scene/light.cpp`, `device_update_lights`):
+/// the receiver, any length), as Cycles 4.x/5.x computes it: `spot_light_attenuation` in
+/// `intern/cycles/kernel/light/spot.h` is `smoothstepf((x − cos_half_spot_angle) ·
+/// spot_smooth)`, with `spot_smooth = 1 / ((1 − cos_half_spot_angle) · blend)` set in
+/// `intern/cycles/scene/light.cpp` (`device_update_lights`), `smoothstepf` clamped to [0, 1]
+/// in `intern/cycles/util/math_float.h`, and `blend = spot_blend`, angle `= spot_size` (full
+/// cone) from `intern/cycles/blender/light.cpp`. That is:
 ///
 /// ```text
 /// x = cos(angle between to_point and the spot axis)
