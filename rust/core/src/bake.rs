@@ -3,6 +3,9 @@
 use std::sync::atomic::AtomicU64;
 use std::time::Instant;
 
+use std::f64::consts::PI;
+
+use glam::DVec3;
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -10,6 +13,7 @@ use crate::edges;
 use crate::elements::{Elements, Region};
 use crate::mesh::{self, ReceiverMesh};
 use crate::regions::{self, ReceiverRegions, RegionTimes};
+use crate::vertex_light;
 
 use crate::progress::Progress;
 use crate::scene::json::SceneJson;
@@ -165,7 +169,13 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
     stats.N_e = elements.triangles.len() as u64;
     stats.N_v = elements.positions.len() as u64;
 
-    let radiance = vec![[0.0f32; 3]; elements.positions.len()];
+    progress.stage("direct light");
+    let t = Instant::now();
+    let (direct, pairs) = vertex_light::direct_irradiance(scene, &elements, progress)?;
+    stats.T_direct = t.elapsed().as_secs_f64();
+    [stats.pairs_umbra, stats.pairs_lit, stats.pairs_penumbra] = pairs;
+
+    let radiance = colors(scene, &elements, &direct);
     let out = output(scene, &elements, &radiance);
     stats.T_total = t_start.elapsed().as_secs_f64();
     Ok(Bake {
@@ -202,6 +212,24 @@ fn assemble(scene: &Scene, meshes: &[ReceiverMesh]) -> Elements {
         }));
     }
     el
+}
+
+/// Outgoing radiance of a Lambertian surface, `albedo · E / π + emission` (what Cycles'
+/// Diffuse bake with direct, indirect and colour gives), or `E / π` for lighting only.
+fn colors(scene: &Scene, el: &Elements, irradiance: &[DVec3]) -> Vec<[f32; 3]> {
+    irradiance
+        .iter()
+        .zip(&el.vertex_face)
+        .map(|(e, &f)| {
+            let face = &scene.faces[f as usize];
+            let c = if scene.settings.lighting_only {
+                *e / PI
+            } else {
+                face.albedo * *e / PI + face.emission
+            };
+            c.as_vec3().to_array()
+        })
+        .collect()
 }
 
 /// Splits the scene-wide elements back into one mesh per input mesh.

@@ -81,8 +81,14 @@ impl<'a> Indexed<'a> {
                 continue;
             }
             if p.umbra {
+                // Keep the occluder: a vertex where umbra meets light without a D0 split
+                // needs it to compute its value exactly.
                 relations[l] = Relation::Umbra;
-                blockers[l].clear();
+                if p.occluder != crate::edges::BEHIND_LIGHT {
+                    blockers[l] = vec![p.occluder];
+                } else {
+                    blockers[l].clear();
+                }
             } else {
                 relations[l] = Relation::Penumbra;
                 blockers[l].push(p.occluder);
