@@ -67,7 +67,7 @@ pub struct BakedMesh {
     pub positions: Vec<[f64; 3]>,
     pub triangles: Vec<[u32; 3]>,
     /// Linear RGB outgoing radiance per vertex.
-    pub colors: Vec<[f32; 3]>,
+    pub colors: Vec<[f64; 3]>,
     /// Per triangle: index of the input polygon it lies in.
     pub source_polygon: Vec<u32>,
     /// Per triangle: one relation code per light (1 lit, 2 penumbra, 3 umbra), in the order
@@ -216,7 +216,7 @@ fn assemble(scene: &Scene, meshes: &[ReceiverMesh]) -> Elements {
 
 /// Outgoing radiance of a Lambertian surface, `albedo · E / π + emission` (what Cycles'
 /// Diffuse bake with direct, indirect and colour gives), or `E / π` for lighting only.
-fn colors(scene: &Scene, el: &Elements, irradiance: &[DVec3]) -> Vec<[f32; 3]> {
+fn colors(scene: &Scene, el: &Elements, irradiance: &[DVec3]) -> Vec<[f64; 3]> {
     irradiance
         .iter()
         .zip(&el.vertex_face)
@@ -227,13 +227,13 @@ fn colors(scene: &Scene, el: &Elements, irradiance: &[DVec3]) -> Vec<[f32; 3]> {
             } else {
                 face.albedo * *e / PI + face.emission
             };
-            c.as_vec3().to_array()
+            c.to_array()
         })
         .collect()
 }
 
 /// Splits the scene-wide elements back into one mesh per input mesh.
-fn output(scene: &Scene, el: &Elements, colors: &[[f32; 3]]) -> Vec<BakedMesh> {
+fn output(scene: &Scene, el: &Elements, colors: &[[f64; 3]]) -> Vec<BakedMesh> {
     let mut out: Vec<BakedMesh> = scene
         .meshes
         .iter()

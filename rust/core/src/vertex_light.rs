@@ -139,7 +139,17 @@ fn vertex_direct(scene: &Scene, el: &Elements, v: usize, regions: &[u32]) -> (DV
                 position,
                 intensity,
                 spot,
-            } => direct::point_light(p, n, *position, *intensity, spot.as_ref(), relation, &polys),
+                radius,
+            } => {
+                let d2 = (*position - p).length_squared();
+                let soft = if *radius > 0.0 {
+                    d2 / (d2 + radius * radius)
+                } else {
+                    1.0
+                };
+                direct::point_light(p, n, *position, *intensity, spot.as_ref(), relation, &polys)
+                    * soft
+            }
             LightKind::Sun {
                 direction,
                 irradiance,

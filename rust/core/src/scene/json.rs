@@ -55,6 +55,9 @@ pub struct LightJson {
     pub intensity: Option<[f64; 3]>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spot: Option<SpotJson>,
+    /// Point/spot only: radius of Blender's soft falloff (irradiance I·cos/(d² + r²)).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub direction: Option<[f64; 3]>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
