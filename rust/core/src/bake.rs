@@ -3,6 +3,7 @@
 use std::sync::atomic::AtomicU64;
 use std::time::Instant;
 
+use std::collections::HashMap;
 use std::f64::consts::PI;
 
 use glam::DVec3;
@@ -232,6 +233,44 @@ fn colors(scene: &Scene, el: &Elements, irradiance: &[DVec3]) -> Vec<[f64; 3]> {
         .collect()
 }
 
+/// Which vertex stands for each vertex in the output: vertices of different faces of one
+/// mesh that coincide, face the same way and carry the same colour become one, so that a
+/// polygon split into convex pieces, or a flat floor of many quads, comes out as one
+/// connected surface. D0 rows keep their two vertices (their colours differ), and so do
+/// creases (their normals differ).
+fn weld(scene: &Scene, el: &Elements, colors: &[[f64; 3]]) -> Vec<u32> {
+    let q = 1e-9 * scene.diagonal().max(1e-300);
+    let cmax = colors
+        .iter()
+        .flat_map(|c| c.iter())
+        .fold(0.0f64, |a, &b| a.max(b.abs()));
+    let mut buckets: HashMap<(u32, [i64; 3]), Vec<u32>> = HashMap::new();
+    let mut canon: Vec<u32> = (0..el.positions.len() as u32).collect();
+    for v in 0..el.positions.len() {
+        let face = el.vertex_face[v] as usize;
+        let key = (
+            scene.faces[face].mesh,
+            el.positions[v].to_array().map(|x| (x / q).round() as i64),
+        );
+        let list = buckets.entry(key).or_default();
+        let c = colors[v];
+        let same = list.iter().copied().find(|&w| {
+            let w = w as usize;
+            el.vertex_face[w] as usize != face
+                && el.normals[w].dot(el.normals[v]) > 1.0 - 1e-9
+                && (0..3).all(|k| {
+                    (colors[w][k] - c[k]).abs()
+                        <= 1e-6 * c[k].abs().max(colors[w][k].abs()) + 1e-12 * cmax
+                })
+        });
+        match same {
+            Some(w) => canon[v] = w,
+            None => list.push(v as u32),
+        }
+    }
+    canon
+}
+
 /// Splits the scene-wide elements back into one mesh per input mesh.
 fn output(scene: &Scene, el: &Elements, colors: &[[f64; 3]]) -> Vec<BakedMesh> {
     let mut out: Vec<BakedMesh> = scene
@@ -242,12 +281,19 @@ fn output(scene: &Scene, el: &Elements, colors: &[[f64; 3]]) -> Vec<BakedMesh> {
             ..BakedMesh::default()
         })
         .collect();
+    let canon = weld(scene, el, colors);
     let mut remap = vec![u32::MAX; el.positions.len()];
     for (t, tri) in el.triangles.iter().enumerate() {
         let f = &scene.faces[el.tri_face[t] as usize];
         let m = &mut out[f.mesh as usize];
         let mut idx = [0u32; 3];
-        for (k, &v) in tri.iter().enumerate() {
+        for (k, &v) in tri
+            .iter()
+            .map(|&v| canon[v as usize])
+            .collect::<Vec<_>>()
+            .iter()
+            .enumerate()
+        {
             if remap[v as usize] == u32::MAX {
                 remap[v as usize] = m.positions.len() as u32;
                 m.positions.push(el.positions[v as usize].to_array());
