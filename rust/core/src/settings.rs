@@ -51,11 +51,13 @@ impl Settings {
             (element_size / 5.0).min(element_size),
         )?;
         let patch_size = positive("patch_size", s.patch_size, element_size * 2.0)?;
+        // Only values the user gave: a derived default follows from one of these.
         for (name, v) in [
-            ("element_size", element_size),
-            ("penumbra_element_size", penumbra_element_size),
-            ("patch_size", patch_size),
+            ("element_size", s.element_size),
+            ("penumbra_element_size", s.penumbra_element_size),
+            ("patch_size", s.patch_size),
         ] {
+            let Some(v) = v else { continue };
             if v < diag * 1e-7 {
                 return Err(BakeError::setting(
                     name,
