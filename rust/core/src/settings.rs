@@ -29,6 +29,8 @@ pub struct Settings {
     pub ambient: bool,
     pub lighting_only: bool,
     pub penumbra_visibility: PenumbraVisibility,
+    /// Mesh uniformly instead of along discontinuities (for comparisons).
+    pub uniform: bool,
     pub penumbra_samples: u32,
     pub visibility_rays: u32,
     pub threads: Option<u32>,
@@ -83,6 +85,16 @@ impl Settings {
                 format!("{convergence} must be in (0, 1)"),
             ));
         }
+        let uniform = match s.meshing.as_deref() {
+            None | Some("discontinuity") => false,
+            Some("uniform") => true,
+            Some(o) => {
+                return Err(BakeError::setting(
+                    "meshing",
+                    format!("{o:?} is not \"discontinuity\" or \"uniform\""),
+                ))
+            }
+        };
         let penumbra_visibility = match s.penumbra_visibility.as_deref() {
             None | Some("exact") => PenumbraVisibility::Exact,
             Some("sampled") => PenumbraVisibility::Sampled,
@@ -128,6 +140,7 @@ impl Settings {
             ambient: s.ambient.unwrap_or(false),
             lighting_only: s.lighting_only.unwrap_or(false),
             penumbra_visibility,
+            uniform,
             penumbra_samples,
             visibility_rays,
             threads: s.threads,
