@@ -70,7 +70,7 @@ fn main() {
     row("elements N_e", &|s, _, _| s.N_e.to_string());
     row("T_d (s)", &|_, td, _| format!("{td:.4}"));
     row("T_m (s)", &|s, _, _| format!("{:.4}", s.T_m));
-    row("bake without lighting (s)", &|_, _, t| format!("{t:.4}"));
+    row("bake, direct light only (s)", &|_, _, t| format!("{t:.4}"));
     println!("\nTable 4 analogue: where T_d goes (s, last run)");
     row("shadow volumes T_sdw", &|s, _, _| format!("{:.4}", s.T_sdw));
     row("volume ∩ receiver T_isr", &|s, _, _| {

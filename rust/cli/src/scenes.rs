@@ -283,8 +283,18 @@ pub fn room(clutter: usize) -> SceneJson {
     )
 }
 
-/// Looks a built-in scene up by name.
+/// Looks a built-in scene up by name: one of `NAMES`, or `data2-SEGxRINGS` (a finer
+/// sphere) or `room-N` (N clutter boxes of 12 triangles each on the table).
 pub fn by_name(name: &str) -> Option<SceneJson> {
+    if let Some(rest) = name.strip_prefix("data2-") {
+        let (a, b) = rest.split_once('x')?;
+        let (seg, rings): (usize, usize) = (a.parse().ok()?, b.parse().ok()?);
+        return (seg >= 3 && rings >= 2 && seg * rings <= 4_000_000).then(|| data2(seg, rings));
+    }
+    if let Some(n) = name.strip_prefix("room-") {
+        let n: usize = n.parse().ok()?;
+        return (n <= 1_000_000).then(|| room(n));
+    }
     Some(match name {
         "data1" => data1(),
         "data2" => data2(32, 16),
@@ -295,4 +305,12 @@ pub fn by_name(name: &str) -> Option<SceneJson> {
     })
 }
 
-pub const NAMES: [&str; 5] = ["data1", "data2", "chair", "cornell", "room"];
+pub const NAMES: [&str; 7] = [
+    "data1",
+    "data2",
+    "chair",
+    "cornell",
+    "room",
+    "data2-SEGxRINGS",
+    "room-N",
+];

@@ -328,20 +328,7 @@ pub fn solid_volumes(
             // vertex), the light's plane, and the solid's faces that have the whole light in
             // front of them.
             let mut planes = Vec::new();
-            separating_planes(lv, &ring(lv.len()), &s.verts, true, &mut planes);
-            let sil: Vec<[u32; 2]> = s
-                .edges
-                .iter()
-                .zip(&s.edge_planes)
-                .filter(|(_, fp)| {
-                    lv.iter().any(|l| {
-                        (s.planes[fp[0] as usize].dist(*l) > 0.0)
-                            != (s.planes[fp[1] as usize].dist(*l) > 0.0)
-                    })
-                })
-                .map(|(e, _)| *e)
-                .collect();
-            separating_planes(&s.verts, &sil, lv, false, &mut planes);
+            solid_separating_planes(lv, plane, s, &mut planes);
             planes.push(*plane);
             for f in &s.planes {
                 if lv.iter().all(|l| f.dist(*l) >= -eps) {
@@ -402,6 +389,95 @@ pub fn solid_volumes(
                 umbra: Some(v),
                 hard: true,
             })
+        }
+    }
+}
+
+/// Separating planes between a light polygon and a convex solid strictly in front of it,
+/// in O(light × solid) rather than by testing every (edge, vertex) pair against every
+/// vertex. Through a light edge, the separating plane touching the solid passes through the
+/// solid vertex of largest angle about that edge, measured from the light's normal towards
+/// the light's interior. Through a light vertex l, the planes touching the solid pass
+/// through its silhouette edges as seen from l, and are supporting planes by convexity, so
+/// only the light's side needs the exact test.
+fn solid_separating_planes(lv: &[DVec3], lplane: &Plane, s: &Solid, out: &mut Vec<Plane>) {
+    let cl = lv.iter().copied().sum::<DVec3>() / lv.len() as f64;
+    let push = |pl: Plane, out: &mut Vec<Plane>| {
+        if !out.iter().any(|o| {
+            (o.n - pl.n).length() < 1e-12 && (o.d - pl.d).abs() < 1e-12 * (1.0 + o.d.abs())
+        }) {
+            out.push(pl);
+        }
+    };
+    let light_on_one_side = |a: DVec3, b: DVec3, c: DVec3| -> Option<i8> {
+        let mut sg = 0i8;
+        for &x in lv {
+            let v = side(a, b, c, x);
+            if v != 0.0 {
+                let t = if v > 0.0 { 1 } else { -1 };
+                if sg != 0 && sg != t {
+                    return None;
+                }
+                sg = t;
+            }
+        }
+        Some(sg)
+    };
+    for i in 0..lv.len() {
+        let (a, b) = (lv[i], lv[(i + 1) % lv.len()]);
+        let u = (b - a).normalize_or_zero();
+        if u == DVec3::ZERO {
+            continue;
+        }
+        let e1 = lplane.n;
+        let mut e2 = u.cross(e1);
+        if e2.dot(cl - a) < 0.0 {
+            e2 = -e2;
+        }
+        let ang = |v: DVec3| (v - a).dot(e2).atan2((v - a).dot(e1));
+        let best = s
+            .verts
+            .iter()
+            .map(|v| ang(*v))
+            .fold(f64::NEG_INFINITY, f64::max);
+        for &v in &s.verts {
+            if ang(v) < best - 1e-9 {
+                continue;
+            }
+            // Exact check that the plane really separates (the angle only nominates).
+            let Some(sl) = light_on_one_side(a, b, v) else {
+                continue;
+            };
+            let solid_ok = s.verts.iter().all(|&x| {
+                let t = side(a, b, v, x);
+                t == 0.0 || (t > 0.0) != (sl > 0)
+            });
+            if sl != 0 && solid_ok {
+                if let Some(pl) = oriented_plane(a, b, v, s.centroid) {
+                    push(pl, out);
+                }
+            }
+        }
+    }
+    for &l in lv {
+        for (e, fp) in s.edges.iter().zip(&s.edge_planes) {
+            let f0 = s.planes[fp[0] as usize].dist(l) > 0.0;
+            let f1 = s.planes[fp[1] as usize].dist(l) > 0.0;
+            if f0 == f1 {
+                continue;
+            }
+            let (a, b) = (s.verts[e[0] as usize], s.verts[e[1] as usize]);
+            let Some(pl) = oriented_plane(a, b, l, s.centroid) else {
+                continue;
+            };
+            // The light must lie wholly on the far side (touching allowed).
+            let light_ok = lv.iter().all(|&x| {
+                let t = side(a, b, l, x);
+                t == 0.0 || (t > 0.0) != (side(a, b, l, s.centroid) > 0.0)
+            });
+            if light_ok {
+                push(pl, out);
+            }
         }
     }
 }
