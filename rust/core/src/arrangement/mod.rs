@@ -174,20 +174,42 @@ pub fn build(boundary: &[DVec2], segments: &[Segment], snap: f64) -> Arrangement
     }
 
     let edges = split::split_all(&mut pool, raw, snap);
-    let vertices = pool.into_points();
-    let edges: Vec<ArrEdge> = edges
-        .into_iter()
-        .map(|e| ArrEdge {
-            v: e.v,
-            tags: e.tags,
-        })
-        .collect();
+    let (vertices, edges) = drop_unused(pool.into_points(), edges);
     let faces = trace::faces(&vertices, &edges);
     Arrangement {
         vertices,
         edges,
         faces,
     }
+}
+
+/// Removes the vertices no edge uses (ends of dropped zero-length segments), keeping order.
+fn drop_unused(points: Vec<DVec2>, edges: Vec<split::Edge>) -> (Vec<DVec2>, Vec<ArrEdge>) {
+    let mut used = vec![false; points.len()];
+    for e in &edges {
+        for &v in &e.v {
+            used[v as usize] = true;
+        }
+    }
+    let mut new_index = vec![u32::MAX; points.len()];
+    let mut vertices = Vec::with_capacity(points.len());
+    for (i, p) in points.into_iter().enumerate() {
+        if used[i] {
+            new_index[i] = vertices.len() as u32;
+            vertices.push(p);
+        }
+    }
+    let edges = edges
+        .into_iter()
+        .map(|e| {
+            let (a, b) = (new_index[e.v[0] as usize], new_index[e.v[1] as usize]);
+            ArrEdge {
+                v: [a.min(b), a.max(b)],
+                tags: e.tags,
+            }
+        })
+        .collect();
+    (vertices, edges)
 }
 
 /// The boundary without repeated points, counter-clockwise; `None` if unusable.

@@ -73,9 +73,9 @@ fn check(arr: &Arrangement, boundary: &[DVec2]) {
         .collect();
     for (i, f) in arr.faces.iter().enumerate() {
         assert!(f.area > 0.0, "face {i} area {}", f.area);
-        assert!(signed_area_2d(&pts(arr, &f.outer)) > 0.0);
+        assert!(local_area(&pts(arr, &f.outer)) > 0.0);
         for h in &f.holes {
-            assert!(signed_area_2d(&pts(arr, h)) < 0.0);
+            assert!(local_area(&pts(arr, h)) < 0.0);
         }
         assert!(f.contains(&arr.vertices, f.interior), "face {i} interior");
         for &e in &f.boundary_edges {
@@ -97,16 +97,31 @@ fn check(arr: &Arrangement, boundary: &[DVec2]) {
     assert_clean(arr);
 }
 
+/// Signed area with coordinates taken relative to the first point, so slivers far from the
+/// origin keep their sign.
+fn local_area(poly: &[DVec2]) -> f64 {
+    let local: Vec<DVec2> = poly.iter().map(|p| *p - poly[0]).collect();
+    signed_area_2d(&local)
+}
+
 fn in_box(a: DVec2, b: DVec2, p: DVec2) -> bool {
     p.x >= a.x.min(b.x) && p.x <= a.x.max(b.x) && p.y >= a.y.min(b.y) && p.y <= a.y.max(b.y)
 }
 
-/// No two edges cross or overlap, no vertex lies inside an edge (exact; all pairs, test only).
+/// No two edges cross or overlap, no vertex lies inside an edge (exact). Pairs come from a
+/// plain sweep over x-intervals, independent of the grid under test.
 fn assert_clean(arr: &Arrangement) {
     let p = |i: u32| arr.vertices[i as usize];
-    for (i, e) in arr.edges.iter().enumerate() {
+    let span = |e: &super::ArrEdge| {
+        let (a, b) = (p(e.v[0]).x, p(e.v[1]).x);
+        (a.min(b), a.max(b))
+    };
+    let mut order: Vec<&super::ArrEdge> = arr.edges.iter().collect();
+    order.sort_by(|e, f| span(e).0.total_cmp(&span(f).0));
+    for (i, e) in order.iter().enumerate() {
         assert_ne!(e.v[0], e.v[1]);
-        for f in &arr.edges[i + 1..] {
+        let right = span(e).1;
+        for f in order[i + 1..].iter().take_while(|f| span(f).0 <= right) {
             let [a, b] = e.v;
             let [c, d] = f.v;
             for (x, (u, w)) in [(c, (a, b)), (d, (a, b)), (a, (c, d)), (b, (c, d))] {
@@ -478,4 +493,145 @@ fn grid_keeps_far_apart_segments_out_of_each_other() {
     let arr = build(&b, &segs, 1e-9);
     assert_eq!(arr.faces.len(), 1);
     assert_eq!(arr.faces[0].boundary_edges.len(), 904);
+}
+
+/// Connected components of the edge graph (vertices without edges not counted).
+fn components(arr: &Arrangement) -> usize {
+    let mut parent: Vec<usize> = (0..arr.vertices.len()).collect();
+    fn find(p: &mut [usize], mut x: usize) -> usize {
+        while p[x] != x {
+            x = p[x];
+        }
+        x
+    }
+    for e in &arr.edges {
+        let (a, b) = (
+            find(&mut parent, e.v[0] as usize),
+            find(&mut parent, e.v[1] as usize),
+        );
+        parent[a] = b;
+    }
+    let mut used = vec![false; arr.vertices.len()];
+    for e in &arr.edges {
+        used[e.v[0] as usize] = true;
+        used[e.v[1] as usize] = true;
+    }
+    (0..arr.vertices.len())
+        .filter(|&v| used[v] && find(&mut parent, v) == v)
+        .count()
+}
+
+/// Segments between random points of a coarse lattice: many exact overlaps, T-junctions and
+/// lines through one point. With `noise`, every coordinate is moved by up to that much, so
+/// the same coincidences must be found by snapping instead.
+fn lattice_case(seed: u64, noise: f64) {
+    let mut rng = Rng(seed);
+    let b = rect(0., 0., 6., 6.);
+    let pick = |rng: &mut Rng| {
+        let q = v((rng.next() % 7) as f64, (rng.next() % 7) as f64);
+        q + v(rng.unit() - 0.5, rng.unit() - 0.5) * 2.0 * noise
+    };
+    let s: Vec<Segment> = (0..40)
+        .map(|k| Segment {
+            a: pick(&mut rng),
+            b: pick(&mut rng),
+            tag: k,
+        })
+        .collect();
+    let arr = build(&b, &s, 1e-9);
+    check(&arr, &b);
+    let c = components(&arr);
+    assert_eq!(
+        arr.faces.len() + arr.vertices.len(),
+        arr.edges.len() + c,
+        "seed {seed}: Euler"
+    );
+    // Every vertex is a lattice point or a crossing: none is a near-duplicate of another.
+    for (i, p) in arr.vertices.iter().enumerate() {
+        for q in &arr.vertices[i + 1..] {
+            assert!((*p - *q).length() > 1e-9);
+        }
+    }
+}
+
+#[test]
+fn lattice_segments_with_exact_coincidences() {
+    for seed in 0..40 {
+        lattice_case(seed, 0.0);
+    }
+}
+
+#[test]
+fn lattice_segments_with_rounding_noise() {
+    for seed in 0..40 {
+        lattice_case(seed, 1e-13);
+    }
+}
+
+/// Each random chord of a pentagon comes with a copy whose ends are moved by up to `eps`
+/// and a partial copy from a point along that copy: bundles of nearly coincident edges,
+/// which only snapping can make coincide.
+fn near_duplicate_chords_case(seed: u64, eps: f64) {
+    let mut rng = Rng(seed + 1000);
+    let b: Vec<DVec2> = (0..5)
+        .map(|k| {
+            let a = k as f64 * std::f64::consts::TAU / 5.0 + 0.1;
+            v(2.0 * a.cos(), 2.0 * a.sin())
+        })
+        .collect();
+    let jiggle = |rng: &mut Rng| v(rng.unit() - 0.5, rng.unit() - 0.5) * 2.0 * eps;
+    let mut s = Vec::new();
+    for k in 0..30u32 {
+        let a = on_boundary(&b, rng.unit());
+        let c = on_boundary(&b, rng.unit());
+        let (a2, c2) = (a + jiggle(&mut rng), c + jiggle(&mut rng));
+        let m = a2.lerp(c2, rng.unit());
+        s.push(Segment { a, b: c, tag: k });
+        s.push(Segment {
+            a: a2,
+            b: c2,
+            tag: 100 + k,
+        });
+        s.push(Segment {
+            a: m,
+            b: c + jiggle(&mut rng),
+            tag: 200 + k,
+        });
+    }
+    let arr = build(&b, &s, 1e-9);
+    check(&arr, &b);
+    let c = components(&arr);
+    assert_eq!(
+        arr.faces.len() + arr.vertices.len(),
+        arr.edges.len() + c,
+        "seed {seed} eps {eps}: Euler"
+    );
+}
+
+#[test]
+fn near_duplicate_chords_snap_together() {
+    for eps in [0.0, 1e-12, 1e-10, 1e-9, 3e-9, 1e-7] {
+        for seed in 0..10 {
+            near_duplicate_chords_case(seed, eps);
+        }
+    }
+}
+
+/// The long version of the near-degenerate tests (about two minutes):
+/// `cargo test -p penumbra arrangement::test::stress -- --ignored`.
+#[test]
+#[ignore]
+fn stress_near_degenerate() {
+    for noise in [0.0, 1e-13, 1e-11, 3e-10, 2e-9] {
+        for seed in 0..400 {
+            lattice_case(seed, noise);
+        }
+    }
+    for eps in [
+        0.0, 1e-14, 1e-12, 1e-10, 5e-10, 1e-9, 2e-9, 3e-9, 5e-9, 1e-8, 1e-7, 1e-6,
+    ] {
+        for seed in 0..400 {
+            near_duplicate_chords_case(seed, eps);
+        }
+    }
 }
