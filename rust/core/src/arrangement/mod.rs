@@ -13,9 +13,12 @@
 //!
 //! # Precision
 //! Every yes/no decision about positions (does it cross, which side, which comes first
-//! around a vertex, is it inside) is an exact predicate on the `f64` coordinates. Only the
-//! coordinates of crossing points are rounded, and those are then snapped to vertices within
-//! `snap`; splitting is repeated until snapping creates no new crossings (a few rounds).
+//! around a vertex, is it inside) is an exact predicate on the `f64` coordinates, except
+//! the deliberate snapping ones (is it within `snap`), which compare `f64` distances.
+//! Crossing points are rounded and then snapped to vertices within `snap`; a vertex within
+//! `snap` of an edge splits it, or merges with its end if that is within a few `snap`.
+//! Splitting is repeated until it finds nothing more, which takes a few rounds; the result
+//! then has no two edges that cross, overlap or touch except at shared end vertices.
 
 mod interior;
 mod snap;
