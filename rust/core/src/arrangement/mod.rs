@@ -233,7 +233,7 @@ fn clean_boundary(boundary: &[DVec2]) -> Option<Vec<DVec2>> {
         return None;
     }
     let area = crate::geom::polygon::signed_area_2d(&pts);
-    if !(area.abs() > 0.0) {
+    if area == 0.0 || area.is_nan() {
         return None;
     }
     if area < 0.0 {
@@ -271,7 +271,7 @@ fn clip_to_convex(poly: &[DVec2], a: DVec2, b: DVec2, snap: f64) -> Option<(DVec
             }
         }
     }
-    if !(t0 < t1) {
+    if t0 >= t1 {
         return None;
     }
     let pa = if t0 > 0.0 { a + (b - a) * t0 } else { a };

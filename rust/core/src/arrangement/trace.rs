@@ -50,7 +50,7 @@ fn angle_cmp(c: DVec2, p: DVec2, q: DVec2) -> Ordering {
 /// but cheaper; only used as a first guess before the exact order.
 fn pseudo_angle(d: DVec2) -> f64 {
     let s = d.x.abs() + d.y.abs();
-    if !(s > 0.0) {
+    if s <= 0.0 || s.is_nan() {
         return 0.0;
     }
     let r = d.x / s;
