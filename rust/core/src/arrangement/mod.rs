@@ -127,6 +127,14 @@ impl Arrangement {
 /// Returns an empty arrangement when the boundary has a non-finite coordinate, no area, a
 /// coordinate beyond [`MAX_COORD`] or a diameter below [`MIN_DIAMETER`].
 ///
+/// # Precision
+/// The receiver corners keep their exact coordinates. Segment ends within `snap` outside
+/// the boundary are moved onto it; a vertex within `snap` of an edge splits it, or merges
+/// with the edge's end when that is within 4 × `snap`. See the module notes.
+///
+/// # Panics
+/// Never: unusable input gives an empty arrangement or drops the offending segment.
+///
 /// ```
 /// use glam::DVec2;
 /// use penumbra::arrangement::{build, Segment};
