@@ -230,3 +230,34 @@ fn stress_near_degenerate() {
         }
     }
 }
+
+/// Garbage in (segments far outside, repeated, zero-length, huge snap): no panic, and with a
+/// sensible snap the faces still tile the receiver.
+#[test]
+fn random_garbage_does_not_panic() {
+    let mut rng = Rng(7);
+    let b = rect(0., 0., 1., 1.);
+    for round in 0..60 {
+        let mut s: Vec<Segment> = (0..40)
+            .map(|k| {
+                let mut p = || v(rng.unit() * 3.0 - 1.0, rng.unit() * 3.0 - 1.0);
+                Segment {
+                    a: p(),
+                    b: p(),
+                    tag: k,
+                }
+            })
+            .collect();
+        s.push(s[0]);
+        s.push(Segment {
+            a: s[1].a,
+            b: s[1].a,
+            tag: 99,
+        });
+        let snap = [0.0, 1e-12, 1e-9, 1e-3, 0.3, 5.0][round % 6];
+        let arr = build(&b, &s, snap);
+        if snap <= 1e-9 {
+            check(&arr, &b);
+        }
+    }
+}
