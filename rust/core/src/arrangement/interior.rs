@@ -44,7 +44,7 @@ pub(super) fn point(pts: &[DVec2], walk: &[(u32, u32)]) -> DVec2 {
         for pair in crossings.windows(2) {
             w += pair[0].1;
             let (x0, x1) = (pair[0].0, pair[1].0);
-            if w == 0 || !(x1 > x0) {
+            if w == 0 || x1 <= x0 {
                 continue;
             }
             let p = DVec2::new(0.5 * (x0 + x1), y);

@@ -13,9 +13,12 @@
 //!
 //! # Precision
 //! Every yes/no decision about positions (does it cross, which side, which comes first
-//! around a vertex, is it inside) is an exact predicate on the `f64` coordinates. Only the
-//! coordinates of crossing points are rounded, and those are then snapped to vertices within
-//! `snap`; splitting is repeated until snapping creates no new crossings (a few rounds).
+//! around a vertex, is it inside) is an exact predicate on the `f64` coordinates, except
+//! the deliberate snapping ones (is it within `snap`), which compare `f64` distances.
+//! Crossing points are rounded and then snapped to vertices within `snap`; a vertex within
+//! `snap` of an edge splits it, or merges with its end if that is within a few `snap`.
+//! Splitting is repeated until it finds nothing more, which takes a few rounds; the result
+//! then has no two edges that cross, overlap or touch except at shared end vertices.
 
 mod interior;
 mod snap;
@@ -124,6 +127,14 @@ impl Arrangement {
 /// Returns an empty arrangement when the boundary has a non-finite coordinate, no area, a
 /// coordinate beyond [`MAX_COORD`] or a diameter below [`MIN_DIAMETER`].
 ///
+/// # Precision
+/// The receiver corners keep their exact coordinates. Segment ends within `snap` outside
+/// the boundary are moved onto it; a vertex within `snap` of an edge splits it, or merges
+/// with the edge's end when that is within 4 × `snap`. See the module notes.
+///
+/// # Panics
+/// Never: unusable input gives an empty arrangement or drops the offending segment.
+///
 /// ```
 /// use glam::DVec2;
 /// use penumbra::arrangement::{build, Segment};
@@ -174,20 +185,42 @@ pub fn build(boundary: &[DVec2], segments: &[Segment], snap: f64) -> Arrangement
     }
 
     let edges = split::split_all(&mut pool, raw, snap);
-    let vertices = pool.into_points();
-    let edges: Vec<ArrEdge> = edges
-        .into_iter()
-        .map(|e| ArrEdge {
-            v: e.v,
-            tags: e.tags,
-        })
-        .collect();
+    let (vertices, edges) = drop_unused(pool.into_points(), edges);
     let faces = trace::faces(&vertices, &edges);
     Arrangement {
         vertices,
         edges,
         faces,
     }
+}
+
+/// Removes the vertices no edge uses (ends of dropped zero-length segments), keeping order.
+fn drop_unused(points: Vec<DVec2>, edges: Vec<split::Edge>) -> (Vec<DVec2>, Vec<ArrEdge>) {
+    let mut used = vec![false; points.len()];
+    for e in &edges {
+        for &v in &e.v {
+            used[v as usize] = true;
+        }
+    }
+    let mut new_index = vec![u32::MAX; points.len()];
+    let mut vertices = Vec::with_capacity(points.len());
+    for (i, p) in points.into_iter().enumerate() {
+        if used[i] {
+            new_index[i] = vertices.len() as u32;
+            vertices.push(p);
+        }
+    }
+    let edges = edges
+        .into_iter()
+        .map(|e| {
+            let (a, b) = (new_index[e.v[0] as usize], new_index[e.v[1] as usize]);
+            ArrEdge {
+                v: [a.min(b), a.max(b)],
+                tags: e.tags,
+            }
+        })
+        .collect();
+    (vertices, edges)
 }
 
 /// The boundary without repeated points, counter-clockwise; `None` if unusable.
@@ -208,7 +241,7 @@ fn clean_boundary(boundary: &[DVec2]) -> Option<Vec<DVec2>> {
         return None;
     }
     let area = crate::geom::polygon::signed_area_2d(&pts);
-    if !(area.abs() > 0.0) {
+    if area == 0.0 || area.is_nan() {
         return None;
     }
     if area < 0.0 {
@@ -246,7 +279,7 @@ fn clip_to_convex(poly: &[DVec2], a: DVec2, b: DVec2, snap: f64) -> Option<(DVec
             }
         }
     }
-    if !(t0 < t1) {
+    if t0 >= t1 {
         return None;
     }
     let pa = if t0 > 0.0 { a + (b - a) * t0 } else { a };

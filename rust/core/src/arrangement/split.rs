@@ -13,10 +13,11 @@ use super::snap::VertexPool;
 use crate::geom::polygon::orient;
 
 /// Snapping a crossing point moves an edge by up to `snap`, which can make it meet an edge
-/// it did not meet before; each round fixes those. Real inputs settle in two rounds; the cap
-/// only guards against pathological ping-pong (the result is then still traced, never a
-/// panic).
-const MAX_ROUNDS: usize = 8;
+/// it did not meet before; each round fixes those. Ordinary inputs settle in one or two
+/// rounds, the bundles of near-duplicate edges in the stress tests in at most nine. Should
+/// the cap be reached, the edges are traced as they are: faces may then be wrong locally,
+/// but nothing panics.
+const MAX_ROUNDS: usize = 16;
 
 /// More cells than this per axis buys nothing for the sizes we see and costs memory.
 const MAX_GRID: usize = 1024;
@@ -39,18 +40,82 @@ impl Edge {
 /// Splits and merges until no pair of edges crosses, touches in an interior point or overlaps.
 pub(super) fn split_all(pool: &mut VertexPool, edges: Vec<Edge>, snap: f64) -> Vec<Edge> {
     let mut edges = merge(edges);
+    let mut alias = Alias::default();
     for _ in 0..MAX_ROUNDS {
         let pairs = candidate_pairs(pool.points(), &edges, snap);
-        let mut splits: Vec<Vec<u32>> = vec![Vec::new(); edges.len()];
+        let mut found = Found {
+            splits: vec![Vec::new(); edges.len()],
+            merges: Vec::new(),
+        };
         for (i, j) in pairs {
-            intersect_pair(pool, &edges, i as usize, j as usize, snap, &mut splits);
+            intersect_pair(
+                pool,
+                &alias,
+                &edges,
+                (i as usize, j as usize),
+                snap,
+                &mut found,
+            );
         }
-        if splits.iter().all(Vec::is_empty) {
+        if !found.merges.is_empty() {
+            // Splits found this round may name merged vertices; the next round finds them
+            // again on the contracted edges.
+            for (p, q) in found.merges {
+                alias.union(p, q);
+            }
+            edges = merge(
+                edges
+                    .into_iter()
+                    .map(|e| Edge {
+                        v: e.v.map(|v| alias.find(v)),
+                        tags: e.tags,
+                    })
+                    .collect(),
+            );
+            continue;
+        }
+        if found.splits.iter().all(Vec::is_empty) {
             break;
         }
-        edges = apply_splits(pool.points(), edges, &splits);
+        edges = apply_splits(pool.points(), edges, &found.splits);
     }
     edges
+}
+
+/// What one round of pair tests asks for.
+struct Found {
+    /// Vertices at which each edge must be split.
+    splits: Vec<Vec<u32>>,
+    /// Vertex pairs to be made one.
+    merges: Vec<(u32, u32)>,
+}
+
+/// Vertices merged into others (union–find; the older vertex represents the set, so the
+/// receiver corners, inserted first, never move).
+#[derive(Default)]
+struct Alias {
+    parent: Vec<u32>,
+}
+
+impl Alias {
+    fn find(&self, mut v: u32) -> u32 {
+        while let Some(&p) = self.parent.get(v as usize) {
+            if p == v {
+                break;
+            }
+            v = p;
+        }
+        v
+    }
+
+    fn union(&mut self, a: u32, b: u32) {
+        let (a, b) = (self.find(a), self.find(b));
+        let n = a.max(b) as usize + 1;
+        if self.parent.len() < n {
+            self.parent.extend(self.parent.len() as u32..n as u32);
+        }
+        self.parent[a.max(b) as usize] = a.min(b);
+    }
 }
 
 /// One edge per vertex pair, carrying the tags of everything that landed on it.
@@ -144,30 +209,42 @@ pub(super) fn candidate_pairs(pts: &[DVec2], edges: &[Edge], snap: f64) -> Vec<(
     pairs
 }
 
-/// Records where edges `i` and `j` must be split so that they meet only at end vertices.
+/// Records where edges `i` and `j` must be split, or which vertices must merge, so that they
+/// meet only at end vertices.
 fn intersect_pair(
     pool: &mut VertexPool,
+    alias: &Alias,
     edges: &[Edge],
-    i: usize,
-    j: usize,
+    (i, j): (usize, usize),
     snap: f64,
-    splits: &mut [Vec<u32>],
+    found: &mut Found,
 ) {
     let [a, b] = edges[i].v;
     let [c, d] = edges[j].v;
     // An end vertex of one lying on (or within `snap` of) the other's interior splits it:
     // T-junctions, collinear overlaps and endpoints on the boundary all come through here.
+    // Such a touch also settles any crossing of the two: once split at the touching vertex
+    // they share it. Computing the crossing as well would give a second, ill-conditioned
+    // point when they are nearly collinear, and the two points would keep splitting the
+    // pieces round after round.
+    let mut touched = false;
     for (p, (u, w), target) in [
         (c, (a, b), i),
         (d, (a, b), i),
         (a, (c, d), j),
         (b, (c, d), j),
     ] {
-        if p != u && p != w && touches_interior(pool.points(), u, w, p, snap) {
-            splits[target].push(p);
+        if p == u || p == w {
+            continue;
         }
+        match touch(pool.points(), u, w, p, snap) {
+            Touch::Apart => continue,
+            Touch::Split => found.splits[target].push(p),
+            Touch::Merge(q) => found.merges.push((p, q)),
+        }
+        touched = true;
     }
-    if a == c || a == d || b == c || b == d {
+    if touched || a == c || a == d || b == c || b == d {
         return;
     }
     let pts = pool.points();
@@ -186,12 +263,12 @@ fn intersect_pair(
     // o3, o4 are twice the signed areas of c-d-a and c-d-b, so they weigh the split of a→b.
     let t = (o3 / (o3 - o4)).clamp(0.0, 1.0);
     let x = pa + (pb - pa) * t;
-    let v = pool.insert(x);
+    let v = alias.find(pool.insert(x));
     if v != a && v != b {
-        splits[i].push(v);
+        found.splits[i].push(v);
     }
     if v != c && v != d {
-        splits[j].push(v);
+        found.splits[j].push(v);
     }
 }
 
@@ -199,29 +276,49 @@ fn opposite(x: f64, y: f64) -> bool {
     (x > 0.0 && y < 0.0) || (x < 0.0 && y > 0.0)
 }
 
-/// Does vertex `p` lie in the open segment `u`–`w` exactly, or within `snap` of it with its
-/// projection strictly between the ends?
-fn touches_interior(pts: &[DVec2], u: u32, w: u32, p: u32, snap: f64) -> bool {
+/// A vertex seen from an edge.
+enum Touch {
+    Apart,
+    /// On the edge's interior, or within `snap` of it: the edge is split there.
+    Split,
+    /// Within `snap` of the edge but also within [`CLUSTER`] × `snap` of this end of it:
+    /// merged with that end instead.
+    Merge(u32),
+}
+
+/// Splitting an edge at a vertex this close to one of its ends leaves pieces so short that,
+/// in a cluster of near-duplicate edges, they can go on splitting each other round after
+/// round (every piece already exists); merging the vertices ends it.
+const CLUSTER: f64 = 4.0;
+
+/// How vertex `p` relates to the segment `u`–`w` (`p` being neither end).
+fn touch(pts: &[DVec2], u: u32, w: u32, p: u32, snap: f64) -> Touch {
     let (a, b, q) = (pts[u as usize], pts[w as usize], pts[p as usize]);
     let ab = b - a;
     let o = orient(a, b, q);
     if o == 0.0 {
         // Exactly collinear: order along the dominant axis is the order along the line.
-        return if ab.x.abs() >= ab.y.abs() {
+        let inside = if ab.x.abs() >= ab.y.abs() {
             q.x > a.x.min(b.x) && q.x < a.x.max(b.x)
         } else {
             q.y > a.y.min(b.y) && q.y < a.y.max(b.y)
         };
+        return if inside { Touch::Split } else { Touch::Apart };
     }
     if snap <= 0.0 {
-        return false;
+        return Touch::Apart;
     }
     let len2 = ab.length_squared();
     let t = (q - a).dot(ab) / len2;
-    if !(t > 0.0 && t < 1.0) {
-        return false;
+    if !(t > 0.0 && t < 1.0) || ab.perp_dot(q - a).abs() / len2.sqrt() > snap {
+        return Touch::Apart;
     }
-    ab.perp_dot(q - a).abs() / len2.sqrt() <= snap
+    let (da, db) = ((q - a).length(), (q - b).length());
+    if da.min(db) <= CLUSTER * snap {
+        Touch::Merge(if da <= db { u } else { w })
+    } else {
+        Touch::Split
+    }
 }
 
 /// Replaces every edge with splits by the chain through its split vertices, in order along it.

@@ -50,7 +50,7 @@ fn angle_cmp(c: DVec2, p: DVec2, q: DVec2) -> Ordering {
 /// but cheaper; only used as a first guess before the exact order.
 fn pseudo_angle(d: DVec2) -> f64 {
     let s = d.x.abs() + d.y.abs();
-    if !(s > 0.0) {
+    if s <= 0.0 || s.is_nan() {
         return 0.0;
     }
     let r = d.x / s;
@@ -162,14 +162,25 @@ fn half_edge(edges: &[ArrEdge], h: u32) -> (u32, u32) {
 
 fn trace_loops(pts: &[DVec2], edges: &[ArrEdge]) -> Vec<Loop> {
     let nh = edges.len() * 2;
-    // Outgoing half-edges of every vertex, counter-clockwise.
-    let mut around: Vec<Vec<u32>> = vec![Vec::new(); pts.len()];
+    // Outgoing half-edges of every vertex, counter-clockwise: those of vertex v are
+    // `around[first[v]..first[v + 1]]`.
+    let mut first = vec![0usize; pts.len() + 1];
     for h in 0..nh as u32 {
-        around[origin(edges, h) as usize].push(h);
+        first[origin(edges, h) as usize + 1] += 1;
+    }
+    for v in 0..pts.len() {
+        first[v + 1] += first[v];
+    }
+    let mut around = vec![0u32; nh];
+    let mut fill = first.clone();
+    for h in 0..nh as u32 {
+        let o = origin(edges, h) as usize;
+        around[fill[o]] = h;
+        fill[o] += 1;
     }
     let mut slot = vec![0u32; nh];
-    for (v, hs) in around.iter_mut().enumerate() {
-        let c = pts[v];
+    for (v, &c) in pts.iter().enumerate() {
+        let hs = &mut around[first[v]..first[v + 1]];
         let to = |h: u32| pts[dest(edges, h) as usize];
         // A rounded key sorts nearly right, and insertion with the exact comparison then
         // fixes the neighbours rounding swapped. Insertion (unlike `sort_by`) cannot panic
@@ -192,7 +203,8 @@ fn trace_loops(pts: &[DVec2], edges: &[ArrEdge]) -> Vec<Loop> {
     // only the way back, so the walk turns around there and goes down the other side.
     let next = |h: u32| -> u32 {
         let back = h ^ 1;
-        let hs = &around[origin(edges, back) as usize];
+        let v = origin(edges, back) as usize;
+        let hs = &around[first[v]..first[v + 1]];
         let i = slot[back as usize] as usize;
         hs[(i + hs.len() - 1) % hs.len()]
     };
