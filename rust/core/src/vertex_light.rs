@@ -9,8 +9,10 @@ use rayon::prelude::*;
 
 use crate::direct;
 use crate::elements::Elements;
+use crate::geom::polygon::convex_hull_2d;
+use crate::geom::{Frame, Plane};
 use crate::relation::Relation;
-use crate::scene::solids::Occluder;
+use crate::scene::solids::{Occluder, Solid};
 use crate::scene::{LightKind, Scene};
 
 /// Direct irradiance (W/m², RGB) per vertex, and the vertex×light counts
@@ -104,20 +106,34 @@ fn vertex_direct(scene: &Scene, el: &Elements, v: usize, regions: &[u32]) -> (DV
             occ.sort_unstable();
             occ.dedup();
         }
-        // A solid hides exactly what its faces turned towards p hide.
-        let polys: Vec<&[DVec3]> = occ
+        // A solid hides exactly what its outline seen from p hides: one convex polygon (or,
+        // failing that, its faces turned towards p).
+        let light_plane = match &light.kind {
+            LightKind::Area { plane, .. } => Some(*plane),
+            _ => None,
+        };
+        let mut owned: Vec<Vec<DVec3>> = Vec::new();
+        let mut face_refs: Vec<u32> = Vec::new();
+        for &o in &occ {
+            match &scene.occluders[o as usize] {
+                Occluder::Face(f) => face_refs.push(*f),
+                Occluder::Solid { faces, solid } => {
+                    match light_plane.and_then(|lp| solid_outline(p, solid, &lp)) {
+                        Some(poly) => owned.push(poly),
+                        None => face_refs.extend(
+                            faces
+                                .iter()
+                                .copied()
+                                .filter(|&f| scene.faces[f as usize].plane.dist(p) > 0.0),
+                        ),
+                    }
+                }
+            }
+        }
+        let polys: Vec<&[DVec3]> = face_refs
             .iter()
-            .flat_map(|&o| {
-                scene.occluders[o as usize]
-                    .faces()
-                    .iter()
-                    .map(move |&f| (o, f))
-            })
-            .filter(|&(o, f)| match &scene.occluders[o as usize] {
-                Occluder::Face(_) => true,
-                Occluder::Solid { .. } => scene.faces[f as usize].plane.dist(p) > 0.0,
-            })
-            .map(|(_, f)| scene.faces[f as usize].verts.as_slice())
+            .map(|&f| scene.faces[f as usize].verts.as_slice())
+            .chain(owned.iter().map(|v| v.as_slice()))
             .collect();
         e += match &light.kind {
             LightKind::Area {
@@ -157,4 +173,38 @@ fn vertex_direct(scene: &Scene, el: &Elements, v: usize, regions: &[u32]) -> (DV
         };
     }
     (e, counts)
+}
+
+/// The outline of a convex solid seen from `p`, as a convex polygon in a plane parallel to
+/// the light halfway between p and the light: a segment from p to a light point crosses it
+/// exactly when it crosses the solid. `None` when the outline does not reach that plane
+/// (part of the solid is no nearer the light than p).
+fn solid_outline(p: DVec3, s: &Solid, lplane: &Plane) -> Option<Vec<DVec3>> {
+    let dp = lplane.dist(p);
+    if !(dp > 0.0) {
+        return None;
+    }
+    let front: Vec<bool> = s.planes.iter().map(|f| f.dist(p) > 0.0).collect();
+    if !front.iter().any(|&f| f) {
+        return None;
+    }
+    let h = 0.5 * dp;
+    let frame = Frame::new(p - lplane.n * (dp - h), lplane.n);
+    let mut pts = Vec::new();
+    for (e, fp) in s.edges.iter().zip(&s.edge_planes) {
+        if front[fp[0] as usize] == front[fp[1] as usize] {
+            continue;
+        }
+        for &vi in e {
+            let v = s.verts[vi as usize];
+            let dv = lplane.dist(v);
+            if dv >= dp * (1.0 - 1e-9) {
+                return None;
+            }
+            let t = (dp - h) / (dp - dv);
+            pts.push(frame.to_2d(p + (v - p) * t));
+        }
+    }
+    let hull = convex_hull_2d(&pts);
+    (hull.len() >= 3).then(|| hull.into_iter().map(|q| frame.to_3d(q)).collect())
 }

@@ -206,3 +206,53 @@ mod test {
         assert_eq!(simplify_convex(&p).len(), 3);
     }
 }
+
+/// Convex hull (counter-clockwise, no collinear points) by Andrew's monotone chain with
+/// exact orientation tests.
+pub fn convex_hull_2d(pts: &[DVec2]) -> Vec<DVec2> {
+    let mut p: Vec<DVec2> = pts.iter().copied().filter(|q| q.is_finite()).collect();
+    p.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    p.dedup();
+    if p.len() < 3 {
+        return p;
+    }
+    let mut hull: Vec<DVec2> = Vec::with_capacity(2 * p.len());
+    for pass in 0..2 {
+        let start = hull.len();
+        let iter: Box<dyn Iterator<Item = &DVec2>> = if pass == 0 {
+            Box::new(p.iter())
+        } else {
+            Box::new(p.iter().rev())
+        };
+        for &q in iter {
+            while hull.len() >= start + 2
+                && orient(hull[hull.len() - 2], hull[hull.len() - 1], q) <= 0.0
+            {
+                hull.pop();
+            }
+            hull.push(q);
+        }
+        hull.pop();
+    }
+    hull
+}
+
+#[cfg(test)]
+mod hull_test {
+    use super::*;
+
+    #[test]
+    fn hull_of_square_with_inner_and_edge_points() {
+        let pts = [
+            DVec2::new(0., 0.),
+            DVec2::new(1., 0.),
+            DVec2::new(0.5, 0.0),
+            DVec2::new(1., 1.),
+            DVec2::new(0., 1.),
+            DVec2::new(0.5, 0.5),
+        ];
+        let h = convex_hull_2d(&pts);
+        assert_eq!(h.len(), 4);
+        assert!((signed_area_2d(&h) - 1.0).abs() < 1e-15);
+    }
+}
