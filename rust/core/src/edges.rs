@@ -198,7 +198,7 @@ pub fn shadow_polygons(
                 let mut out = Vec::new();
                 for v in vs {
                     for p in &v.penumbra {
-                        tree.query_volume(&p.planes, eps, &mut out);
+                        tree.query_volume(p.query_planes(), eps, &mut out);
                     }
                 }
                 out.sort_unstable();
@@ -269,6 +269,7 @@ fn receiver_polygons(
             r,
             &Volume {
                 planes: vec![plane.flipped()],
+                cap: 0,
             },
             eps,
         ) {

@@ -25,9 +25,17 @@ use crate::scene::{Face, LightKind};
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Volume {
     pub planes: Vec<Plane>,
+    /// How many trailing planes a broad-phase query may leave out (a solid's front cap:
+    /// they bound the volume on the light's side, where receivers seldom are).
+    pub cap: usize,
 }
 
 impl Volume {
+    /// The planes a conservative "may this box touch the volume" query needs.
+    pub fn query_planes(&self) -> &[Plane] {
+        &self.planes[..self.planes.len() - self.cap.min(self.planes.len())]
+    }
+
     pub fn contains(&self, p: DVec3, eps: f64) -> bool {
         self.planes.iter().all(|h| h.dist(p) >= -eps)
     }
@@ -165,7 +173,7 @@ fn penumbra_volume(l: &[DVec3], o: &[DVec3]) -> Volume {
         };
         planes.push(pl);
     }
-    Volume { planes }
+    Volume { planes, cap: 0 }
 }
 
 /// Shadow volume of occluder `o` from point `l`: the cone from l through o, beyond o.
@@ -185,7 +193,7 @@ fn point_volume(l: DVec3, o: &[DVec3], o_plane: &Plane) -> Option<Volume> {
     } else {
         *o_plane
     });
-    Some(Volume { planes })
+    Some(Volume { planes, cap: 0 })
 }
 
 /// Shadow volume of occluder `o` under a directional light travelling along `dir`.
@@ -212,7 +220,7 @@ fn sun_volume(dir: DVec3, o: &[DVec3], o_plane: &Plane) -> Option<Volume> {
     } else {
         o_plane.flipped()
     });
-    Some(Volume { planes })
+    Some(Volume { planes, cap: 0 })
 }
 
 /// Shadow volumes of `occluder` (face index `oi`) for a light of the given kind, or `None`
@@ -262,7 +270,7 @@ pub fn shadow_volumes(
                 }
                 if ok {
                     planes.push(*plane);
-                    umbra = Some(Volume { planes });
+                    umbra = Some(Volume { planes, cap: 0 });
                 }
             } else {
                 return None;
@@ -330,12 +338,14 @@ pub fn solid_volumes(
             let mut planes = Vec::new();
             solid_separating_planes(lv, plane, s, &mut planes);
             planes.push(*plane);
+            let before = planes.len();
             for f in &s.planes {
                 if lv.iter().all(|l| f.dist(*l) >= -eps) {
                     planes.push(f.flipped());
                 }
             }
-            let penumbra = Volume { planes };
+            let cap = planes.len() - before;
+            let penumbra = Volume { planes, cap };
             let mut umbra_planes = vec![*plane];
             for &l in lv {
                 match point_solid_volume(l, s, eps) {
@@ -348,6 +358,7 @@ pub fn solid_volumes(
                 penumbra: vec![penumbra],
                 umbra: Some(Volume {
                     planes: umbra_planes,
+                    cap: 0,
                 }),
                 hard: false,
             })
@@ -382,7 +393,7 @@ pub fn solid_volumes(
                     planes.push(f.flipped());
                 }
             }
-            let v = Volume { planes };
+            let v = Volume { planes, cap: 0 };
             SolidShadow::Volumes(ShadowVolumes {
                 occluder: oi,
                 penumbra: vec![v.clone()],
@@ -505,7 +516,7 @@ fn point_solid_volume(l: DVec3, s: &Solid, eps: f64) -> Option<Volume> {
             planes.push(f.flipped());
         }
     }
-    Some(Volume { planes })
+    Some(Volume { planes, cap: 0 })
 }
 
 #[cfg(test)]

@@ -155,12 +155,16 @@ fn convex_solid(pos: &[DVec3], polys: &[Vec<u32>], comp: &[u32]) -> Option<Solid
         .iter()
         .fold(DVec3::splat(f64::NEG_INFINITY), |a, v| a.max(*v));
     let tol = 1e-9 * (hi - lo).length();
+    let global = comp.len() * verts.len() <= 1 << 20;
     let mut planes = Vec::with_capacity(comp.len());
     for &p in comp {
         let pts: Vec<DVec3> = polys[p as usize].iter().map(|&v| pos[v as usize]).collect();
         let pl = Plane::from_polygon(&pts)?;
-        // Planar polygons only, and every vertex of the solid behind every face: convex.
-        if pts.iter().any(|x| pl.dist(*x).abs() > tol) || verts.iter().any(|x| pl.dist(*x) > tol) {
+        // Planar polygons only; and every vertex of the solid behind every face (convex),
+        // checked here in full while that is cheap, else locally at every edge below.
+        if pts.iter().any(|x| pl.dist(*x).abs() > tol)
+            || (global && verts.iter().any(|x| pl.dist(*x) > tol))
+        {
             return None;
         }
         planes.push(pl);
@@ -192,6 +196,25 @@ fn convex_solid(pos: &[DVec3], polys: &[Vec<u32>], comp: &[u32]) -> Option<Solid
     // with one polygon would mean the component is not closed after all.
     if edge_planes.iter().any(|e| e[1] == u32::MAX) {
         return None;
+    }
+    if !global {
+        // Convex at every edge, and a topological sphere (V − E + F = 2): together these make
+        // a closed surface the boundary of a convex body (a locally convex closed polyhedral
+        // surface of genus 0 is convex unless it passes through itself).
+        let behind = |a: u32, b: u32| {
+            polys[comp[b as usize] as usize]
+                .iter()
+                .all(|&v| planes[a as usize].dist(pos[v as usize]) <= tol)
+        };
+        if edge_planes
+            .iter()
+            .any(|&[a, b]| !behind(a, b) || !behind(b, a))
+        {
+            return None;
+        }
+        if verts.len() as i64 - edges.len() as i64 + comp.len() as i64 != 2 {
+            return None;
+        }
     }
     let centroid = verts.iter().copied().sum::<DVec3>() / verts.len() as f64;
     Some(Solid {
