@@ -1,0 +1,24 @@
+//! The same scene gives bit-identical output on 1 and on several threads.
+
+mod common;
+use common::*;
+
+#[test]
+fn one_and_four_threads_agree_bit_for_bit() {
+    let mut meshes = vec![mesh("Floor", vec![quad([0., 0., 0.], 2., 2., true)])];
+    meshes.push(mesh("Box", cuboid([-0.3, -0.2, 0.0], [0.3, 0.4, 0.5])));
+    meshes.push(mesh("Ball", uv_sphere([0.8, 0.6, 0.9], 0.3, 12, 8)));
+    meshes.push(mesh("Panel", vec![quad([-0.7, 0.5, 1.1], 0.3, 0.2, false)]));
+    let lights = vec![
+        area_light("Key", quad([0.5, 0.3, 2.0], 0.3, 0.2, false)),
+        point_light("Bulb", [-1.0, -1.0, 1.5]),
+    ];
+    let mut s = scene(meshes, lights, Default::default());
+    let mut out = Vec::new();
+    for threads in [1, 4] {
+        s.settings.threads = Some(threads);
+        let b = bake(&s);
+        out.push(serde_json::to_string(&b.meshes).unwrap());
+    }
+    assert_eq!(out[0], out[1]);
+}
