@@ -28,7 +28,7 @@ enum Command {
     /// Bake SCENE (scene JSON, `-` for stdin) and write the bake JSON.
     Bake {
         scene: PathBuf,
-        /// Output file (bake JSON); `-` for stdout.
+        /// Output file: bake JSON, or binary glTF when it ends in `.glb`; `-` for stdout (JSON).
         #[arg(short, long)]
         output: PathBuf,
         /// Print the stats table (paper's names) to stderr when done.
@@ -164,12 +164,16 @@ fn run(cli: Cli) -> ExitCode {
                 Err(e @ BakeError::Cancelled) => return fail(1, e),
                 Err(e) => return fail(2, e),
             };
-            let json = bake.to_json();
+            let glb = output
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
             let written = if output.as_os_str() == "-" {
-                println!("{json}");
+                println!("{}", bake.to_json());
                 Ok(())
+            } else if glb {
+                std::fs::write(&output, penumbra_cli::gltf::to_glb(&bake))
             } else {
-                std::fs::write(&output, json)
+                std::fs::write(&output, bake.to_json())
             };
             if let Err(e) = written {
                 return fail(1, format!("{}: {e}", output.display()));

@@ -150,3 +150,30 @@ fn builtin_scenes_bake() {
         );
     }
 }
+
+#[test]
+fn writes_binary_gltf() {
+    let p = write("good-glb.json", GOOD);
+    let o = p.with_extension("glb");
+    let out = penumbra()
+        .args(["bake", p.to_str().unwrap(), "-o", o.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    let b = std::fs::read(&o).unwrap();
+    assert_eq!(&b[0..4], b"glTF");
+    assert_eq!(
+        u32::from_le_bytes(b[8..12].try_into().unwrap()) as usize,
+        b.len()
+    );
+    let jlen = u32::from_le_bytes(b[12..16].try_into().unwrap()) as usize;
+    assert_eq!(&b[16..20], b"JSON");
+    let doc: serde_json::Value = serde_json::from_slice(&b[20..20 + jlen]).unwrap();
+    assert_eq!(doc["nodes"][0]["name"], "Floor_baked");
+    assert_eq!(doc["meshes"].as_array().unwrap().len(), 2);
+    let bin_len = u32::from_le_bytes(b[20 + jlen..24 + jlen].try_into().unwrap()) as usize;
+    assert_eq!(
+        doc["buffers"][0]["byteLength"].as_u64().unwrap() as usize,
+        bin_len
+    );
+}
