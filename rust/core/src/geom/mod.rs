@@ -6,6 +6,7 @@ pub mod bvh;
 pub mod frame;
 pub mod plane;
 pub mod polygon;
+pub mod raycast;
 
 pub use frame::Frame;
 pub use plane::Plane;
