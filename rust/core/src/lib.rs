@@ -8,6 +8,8 @@ pub mod bake;
 pub mod elements;
 pub mod error;
 pub mod geom;
+pub mod indirect;
+pub mod patches;
 pub mod progress;
 pub mod relation;
 pub mod scene;

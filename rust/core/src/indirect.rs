@@ -1,0 +1,438 @@
+//! Stage 7: indirect light by progressive refinement (Cohen, Chen, Wallace & Greenberg 1988),
+//! as in the paper's §2.6: the patch with the most unshot power shoots it to every element
+//! vertex that can see it, until what is left is a small fraction of what was emitted.
+//!
+//! Units follow `DESIGN.md`: irradiance E and radiosity B in W/m² per RGB channel; a face's
+//! `emission` is radiance, so it leaves the face as radiosity π·Le.
+//!
+//! Form factors are exact point-to-polygon integrals (Lambert's formula) times a visible
+//! fraction from rays to stratified points on the patch. Most pairs need no rays: a face
+//! can only be in the way if it pokes out in front of both the shooter's and the receiver's
+//! planes inside the box around them ([`Occluders::candidates`]), which for convex objects
+//! and floors is never. Shots are parallel over receiver vertices; each vertex's value is
+//! computed alone and added in a fixed order, so results do not depend on the thread count.
+
+use std::f64::consts::PI;
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::elements::Elements;
+use crate::geom::polygon::clip_polygon_3d;
+use crate::geom::raycast::Occluders;
+use crate::geom::Plane;
+use crate::patches::{build_patches, Patch};
+use crate::progress::Progress;
+use crate::scene::Scene;
+use crate::BakeError;
+
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct IndirectResult {
+    /// Indirect irradiance (W/m², RGB) at each element vertex: everything that arrives after
+    /// at least one diffuse bounce, plus what emissive faces send.
+    pub irradiance: Vec<DVec3>,
+    pub patches: u64,
+    pub shots: u64,
+    /// Unshot power left at the end over the power emitted (reflected direct light plus
+    /// emission), before any ambient term.
+    pub unshot_fraction: f64,
+}
+
+/// Patches whose apparent size (radius over distance) falls under these use 1 or ~4 rays
+/// instead of `visibility_rays`: a far patch is seen nearly all or nothing.
+const FEW_RAYS_BELOW: f64 = 0.15;
+const ONE_RAY_BELOW: f64 = 0.06;
+/// Candidate occluder lists longer than this are handed to the BVH instead.
+const MAX_LISTED_OCCLUDERS: usize = 24;
+/// Receiver vertices per parallel work item.
+const CHUNK: usize = 256;
+
+/// Progressive-refinement radiosity over the element mesh `el` of `scene`, starting from
+/// the direct irradiance `direct` (one per element vertex). Checks `progress` for
+/// cancellation between shots.
+pub fn indirect(
+    scene: &Scene,
+    el: &Elements,
+    direct: &[DVec3],
+    occ: &Occluders,
+    progress: &Progress,
+) -> Result<IndirectResult, BakeError> {
+    let settings = &scene.settings;
+    let nv = el.positions.len();
+    if direct.len() != nv {
+        return Err(BakeError::invalid(
+            "indirect",
+            "direct",
+            format!("{} values for {nv} element vertices", direct.len()),
+        ));
+    }
+    let patches = build_patches(
+        &scene.faces,
+        el,
+        settings.patch_size,
+        settings.visibility_rays,
+    );
+    let albedo = |p: &Patch| scene.faces[p.face as usize].albedo;
+    let mut unshot: Vec<DVec3> = patches
+        .iter()
+        .map(|p| albedo(p) * mean(&p.weights, direct) + PI * scene.faces[p.face as usize].emission)
+        .collect();
+    let power = |b: DVec3, p: &Patch| b.element_sum() * p.area;
+    let emitted: f64 = unshot.iter().zip(&patches).map(|(b, p)| power(*b, p)).sum();
+    let mut irradiance = vec![DVec3::ZERO; nv];
+    let mut result = IndirectResult {
+        patches: patches.len() as u64,
+        ..Default::default()
+    };
+    if !(emitted > 0.0) || !emitted.is_finite() {
+        result.irradiance = irradiance;
+        return Ok(result);
+    }
+
+    let shooter = Shooter::new(scene, el, &patches, occ, emitted);
+    let mut received = vec![DVec3::ZERO; nv];
+    let mut remaining;
+    loop {
+        progress.check()?;
+        let mut best = 0;
+        remaining = 0.0;
+        for (i, (b, p)) in unshot.iter().zip(&patches).enumerate() {
+            let w = power(*b, p);
+            remaining += w;
+            if w > power(unshot[best], &patches[best]) {
+                best = i;
+            }
+        }
+        let fraction = remaining / emitted;
+        let by_energy = (fraction.max(1e-300).ln() / settings.convergence.ln()).clamp(0.0, 1.0);
+        progress
+            .set_fraction(by_energy.max(result.shots as f64 / settings.max_shots.max(1) as f64));
+        if fraction < settings.convergence || result.shots >= settings.max_shots {
+            break;
+        }
+
+        let b = std::mem::take(&mut unshot[best]);
+        let faces = shooter.shoot(best, b, &mut received);
+        for f in faces {
+            let rho = scene.faces[f as usize].albedo;
+            for &v in shooter.verts_of(f) {
+                irradiance[v as usize] += received[v as usize];
+            }
+            for (p, q) in patches
+                .iter()
+                .enumerate()
+                .skip(shooter.first_patch[f as usize] as usize)
+            {
+                if q.face != f {
+                    break;
+                }
+                unshot[p] += rho * mean(&q.weights, &received);
+            }
+            for &v in shooter.verts_of(f) {
+                received[v as usize] = DVec3::ZERO;
+            }
+        }
+        result.shots += 1;
+    }
+    result.unshot_fraction = remaining / emitted;
+
+    if settings.ambient {
+        let amb = ambient(&patches, &unshot, |p| albedo(p));
+        irradiance.iter_mut().for_each(|e| *e += amb);
+    }
+    result.irradiance = irradiance;
+    Ok(result)
+}
+
+/// Cohen et al.'s ambient term: the unshot radiosity, averaged over the scene's area, after
+/// endless bounces off a surface of the average reflectance. Assumes a closed scene; in an
+/// open one part of that light would escape, so this overestimates.
+fn ambient(patches: &[Patch], unshot: &[DVec3], albedo: impl Fn(&Patch) -> DVec3) -> DVec3 {
+    let area: f64 = patches.iter().map(|p| p.area).sum();
+    if !(area > 0.0) {
+        return DVec3::ZERO;
+    }
+    let rho = patches.iter().map(|p| albedo(p) * p.area).sum::<DVec3>() / area;
+    let u = unshot
+        .iter()
+        .zip(patches)
+        .map(|(b, p)| *b * p.area)
+        .sum::<DVec3>()
+        / area;
+    // A white scene would bounce forever; cap the series at a thousand bounces.
+    u / (DVec3::ONE - rho.min(DVec3::splat(0.999)))
+}
+
+fn mean(weights: &[(u32, f64)], values: &[DVec3]) -> DVec3 {
+    weights.iter().map(|&(v, w)| values[v as usize] * w).sum()
+}
+
+/// What a shot needs about the scene, built once.
+struct Shooter<'a> {
+    scene: &'a Scene,
+    el: &'a Elements,
+    patches: &'a [Patch],
+    occ: &'a Occluders,
+    /// Element vertices of face f: `face_verts[vert_start[f]..vert_start[f + 1]]`.
+    vert_start: Vec<u32>,
+    face_verts: Vec<u32>,
+    /// First patch of each face (patches are sorted by face).
+    first_patch: Vec<u32>,
+    /// Faces that have element vertices.
+    receivers: Vec<u32>,
+    /// Vertex positions nudged into their face (see `Shooter::new`).
+    points: Vec<DVec3>,
+    /// Irradiance under which a vertex's share of a shot is too small to be worth full
+    /// visibility sampling.
+    negligible: f64,
+    tol: f64,
+}
+
+/// A receiver face in one shot: the shooter clipped to the face's front half-space, and
+/// which faces could block the rays between them.
+struct Pair {
+    face: u32,
+    poly: Vec<DVec3>,
+    /// A point of `poly`, for when no sample of the patch lies in front of the face.
+    inner: DVec3,
+    vis: Blockers,
+}
+
+enum Blockers {
+    None,
+    Listed(Vec<u32>),
+    Any,
+}
+
+impl<'a> Shooter<'a> {
+    fn new(
+        scene: &'a Scene,
+        el: &'a Elements,
+        patches: &'a [Patch],
+        occ: &'a Occluders,
+        emitted: f64,
+    ) -> Self {
+        let nf = scene.faces.len();
+        let mut vert_start = vec![0u32; nf + 1];
+        for &f in &el.vertex_face {
+            vert_start[f as usize + 1] += 1;
+        }
+        for f in 0..nf {
+            vert_start[f + 1] += vert_start[f];
+        }
+        let mut fill = vert_start.clone();
+        let mut face_verts = vec![0u32; el.vertex_face.len()];
+        for (v, &f) in el.vertex_face.iter().enumerate() {
+            face_verts[fill[f as usize] as usize] = v as u32;
+            fill[f as usize] += 1;
+        }
+        let mut first_patch = vec![patches.len() as u32; nf];
+        for (i, p) in patches.iter().enumerate().rev() {
+            first_patch[p.face as usize] = i as u32;
+        }
+        let receivers = (0..nf as u32)
+            .filter(|&f| vert_start[f as usize + 1] > vert_start[f as usize])
+            .collect();
+        // A vertex on the edge where a wall meets the floor lies in the wall's plane and
+        // would see the wall edge-on: no light from it at all, though a point a hair inside
+        // the floor gets plenty. Evaluating a hair inside gives the limit from the face,
+        // which is what the element's interior shows.
+        let tol = occ.tolerance();
+        let centres: Vec<DVec3> = scene
+            .faces
+            .iter()
+            .map(|f| f.verts.iter().copied().sum::<DVec3>() / f.verts.len().max(1) as f64)
+            .collect();
+        let points = el
+            .positions
+            .iter()
+            .zip(&el.vertex_face)
+            .map(|(x, &f)| {
+                let d = centres[f as usize] - *x;
+                let l = d.length();
+                if l > 0.0 {
+                    *x + d * (1e-6f64).max(100.0 * tol / l).min(0.5)
+                } else {
+                    *x
+                }
+            })
+            .collect();
+        let area: f64 = patches.iter().map(|p| p.area).sum();
+        let negligible = 1e-3 * scene.settings.convergence * emitted / area.max(f64::MIN_POSITIVE);
+        Shooter {
+            scene,
+            el,
+            patches,
+            occ,
+            vert_start,
+            face_verts,
+            first_patch,
+            receivers,
+            points,
+            negligible,
+            tol,
+        }
+    }
+
+    fn verts_of(&self, f: u32) -> &[u32] {
+        &self.face_verts
+            [self.vert_start[f as usize] as usize..self.vert_start[f as usize + 1] as usize]
+    }
+
+    /// Shoots radiosity `b` from patch `p`: adds each vertex's irradiance to `received`
+    /// and returns the faces that got some (ascending).
+    fn shoot(&self, p: usize, b: DVec3, received: &mut [DVec3]) -> Vec<u32> {
+        let patch = &self.patches[p];
+        let plane = self.scene.faces[patch.face as usize].plane;
+        let pairs: Vec<Pair> = self
+            .receivers
+            .par_iter()
+            .filter_map(|&f| self.pair(patch, &plane, f))
+            .collect();
+        let chunks: Vec<(usize, usize, usize)> = pairs
+            .iter()
+            .enumerate()
+            .flat_map(|(k, pair)| {
+                let n = self.verts_of(pair.face).len();
+                (0..n)
+                    .step_by(CHUNK)
+                    .map(move |s| (k, s, (s + CHUNK).min(n)))
+            })
+            .collect();
+        let values: Vec<Vec<DVec3>> = chunks
+            .par_iter()
+            .map(|&(k, s, e)| {
+                let pair = &pairs[k];
+                self.verts_of(pair.face)[s..e]
+                    .iter()
+                    .map(|&v| self.receive(patch, &plane, pair, v, b))
+                    .collect()
+            })
+            .collect();
+        for (&(k, s, _), vals) in chunks.iter().zip(values) {
+            for (&v, e) in self.verts_of(pairs[k].face)[s..].iter().zip(vals) {
+                received[v as usize] = e;
+            }
+        }
+        pairs.iter().map(|p| p.face).collect()
+    }
+
+    /// The shooter as receiver face `f` sees it, or `None` if no vertex of `f` can get light
+    /// from it.
+    fn pair(&self, patch: &Patch, plane: &Plane, f: u32) -> Option<Pair> {
+        if f == patch.face {
+            return None;
+        }
+        let face = &self.scene.faces[f as usize];
+        // The face's vertices lie in its polygon, so if its corners are all behind the
+        // shooter, so are they.
+        if face.verts.iter().all(|v| plane.dist(*v) <= self.tol) {
+            return None;
+        }
+        let poly = clip_polygon_3d(&patch.poly, &face.plane, self.tol);
+        if poly.len() < 3 {
+            return None;
+        }
+        let inner = poly.iter().copied().sum::<DVec3>() / poly.len() as f64;
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        for v in poly.iter().chain(&face.verts) {
+            lo = lo.min(*v);
+            hi = hi.max(*v);
+        }
+        let mut list = Vec::new();
+        self.occ
+            .candidates(lo, hi, &[*plane, face.plane], &[patch.face, f], &mut list);
+        let vis = match list.len() {
+            0 => Blockers::None,
+            n if n <= MAX_LISTED_OCCLUDERS => Blockers::Listed(list),
+            _ => Blockers::Any,
+        };
+        Some(Pair {
+            face: f,
+            poly,
+            inner,
+            vis,
+        })
+    }
+
+    /// Irradiance at vertex `v` from the shooter.
+    fn receive(&self, patch: &Patch, plane: &Plane, pair: &Pair, v: u32, b: DVec3) -> DVec3 {
+        let x = self.points[v as usize];
+        if plane.dist(x) <= self.tol {
+            return DVec3::ZERO;
+        }
+        let n = self.el.normals[v as usize];
+        let ff = form_factor(x, n, &pair.poly);
+        if !(ff > 0.0) {
+            return DVec3::ZERO;
+        }
+        let e = b * ff;
+        let vis = match &pair.vis {
+            Blockers::None => 1.0,
+            blockers => {
+                let size = patch.radius / (patch.centroid - x).length();
+                let level = if e.max_element() < self.negligible || size < ONE_RAY_BELOW {
+                    0
+                } else if size < FEW_RAYS_BELOW {
+                    1
+                } else {
+                    2
+                };
+                let skip = [patch.face, pair.face];
+                let blocked = |s: DVec3| match blockers {
+                    Blockers::Listed(list) => self.occ.segment_blocked_by(x, s, list),
+                    _ => self.occ.segment_blocked_skip(x, s, &skip),
+                };
+                // Each ray counts by its own point-to-point form factor, cosθ·cosθ'/r², not
+                // one each (Wallace, Elmquist & Haines 1989): with the near half of a patch
+                // hidden, an unweighted count would keep twice too much light.
+                let np = plane.n;
+                let (mut seen, mut total) = (0.0, 0.0);
+                for &s in &patch.samples[level] {
+                    let d = s - x;
+                    let w = n.dot(d) * -np.dot(d) / d.length_squared().powi(2);
+                    if w > 0.0 {
+                        total += w;
+                        if !blocked(s) {
+                            seen += w;
+                        }
+                    }
+                }
+                if !(total > 0.0) {
+                    (!blocked(pair.inner)) as u8 as f64
+                } else {
+                    seen / total
+                }
+            }
+        };
+        e * vis
+    }
+}
+
+/// Irradiance at `x` (unit normal `n`) from a polygon of unit radiance, over π: the
+/// point-to-polygon form factor by Lambert's formula, ½·Σ θ_k (n·Γ_k) / π, with θ_k the
+/// angle the k-th edge subtends at `x` and Γ_k the unit normal of the plane through `x`
+/// and that edge. The polygon must run counter-clockwise seen from its front, with `x` in
+/// front of it and the polygon in front of `x` (clip it to `x`'s tangent plane first).
+fn form_factor(x: DVec3, n: DVec3, poly: &[DVec3]) -> f64 {
+    let mut s = 0.0;
+    let Some(last) = poly.last() else { return 0.0 };
+    let mut a = *last - x;
+    for q in poly {
+        let b = *q - x;
+        let c = a.cross(b);
+        let l = c.length();
+        // θ from atan2 stays accurate for edges seen nearly end-on, where acos of the
+        // normalised dot product loses all its digits.
+        if l > 0.0 {
+            s += l.atan2(a.dot(b)) * n.dot(c) / l;
+        }
+        a = b;
+    }
+    // Seen from its front the polygon runs clockwise, so each n·Γ_k is negative.
+    (-s / (2.0 * PI)).max(0.0)
+}
+
+#[cfg(test)]
+mod test;

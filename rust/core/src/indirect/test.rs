@@ -1,0 +1,338 @@
+//! Tests of the indirect stage against closed forms and the white furnace.
+
+use super::*;
+use crate::geom::raycast::test::face;
+use crate::patches::test::grid_elements;
+use crate::scene::json::SettingsJson;
+use crate::scene::Face;
+use crate::settings::Settings;
+
+fn v(x: f64, y: f64, z: f64) -> DVec3 {
+    DVec3::new(x, y, z)
+}
+
+/// A parallelogram centred at `c` facing `u × v`.
+fn quad(c: DVec3, u: DVec3, w: DVec3, albedo: f64, le: DVec3) -> Face {
+    face(
+        &[c - u - w, c + u - w, c + u + w, c - u + w],
+        DVec3::splat(albedo),
+        le,
+    )
+}
+
+fn scene(faces: Vec<Face>, settings: impl FnOnce(&mut Settings)) -> Scene {
+    let mut s = Settings::from_json(&SettingsJson::default(), 1.0).unwrap();
+    settings(&mut s);
+    let pts = faces.iter().flat_map(|f| f.verts.iter().copied());
+    let lo = pts.clone().fold(DVec3::splat(f64::INFINITY), DVec3::min);
+    let hi = pts.fold(DVec3::splat(f64::NEG_INFINITY), DVec3::max);
+    Scene {
+        meshes: vec![],
+        faces,
+        lights: vec![],
+        settings: s,
+        bounds_min: lo,
+        bounds_max: hi,
+        warnings: vec![],
+    }
+}
+
+fn run(scene: &Scene, k: usize) -> (Elements, IndirectResult) {
+    let el = grid_elements(&scene.faces, k);
+    let occ = Occluders::new(&scene.faces);
+    let direct = vec![DVec3::ZERO; el.positions.len()];
+    let r = indirect(scene, &el, &direct, &occ, &Progress::new()).unwrap();
+    (el, r)
+}
+
+/// Form factor from a point to a parallel rectangle a × b at height c, the point under
+/// one of its corners (Howell's catalogue, C-11).
+fn corner(a: f64, b: f64, c: f64) -> f64 {
+    let (x, y) = (a / c, b / c);
+    let (sx, sy) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());
+    (x / sx * (y / sx).atan() + y / sy * (x / sy).atan()) / (2.0 * PI)
+}
+
+#[test]
+fn form_factor_matches_closed_forms() {
+    // Unit square at height 1 facing down, the point under a corner.
+    let sq = [v(0., 0., 1.), v(0., 1., 1.), v(1., 1., 1.), v(1., 0., 1.)];
+    let f = form_factor(DVec3::ZERO, DVec3::Z, &sq);
+    assert!((f - corner(1.0, 1.0, 1.0)).abs() < 1e-15, "{f}");
+    assert!((f - 0.138531605994893).abs() < 1e-14);
+    // Far and small: A cosθ cosθ' / (π r²).
+    let c = v(3.0, 0.0, 4.0);
+    let h = 1e-3;
+    let n = v(-3.0, 0.0, -4.0) / 5.0;
+    let t = n.cross(DVec3::Y) * h;
+    let small = [
+        c - t - DVec3::Y * h,
+        c - t + DVec3::Y * h,
+        c + t + DVec3::Y * h,
+        c + t - DVec3::Y * h,
+    ];
+    let small: Vec<_> = if Plane::from_polygon(&small).unwrap().n.dot(n) > 0.0 {
+        small.to_vec()
+    } else {
+        small.iter().rev().copied().collect()
+    };
+    let expect = 4.0 * h * h * 0.8 * 1.0 / (PI * 25.0);
+    assert!((form_factor(DVec3::ZERO, DVec3::Z, &small) / expect - 1.0).abs() < 1e-6);
+    // A huge square covers the whole hemisphere.
+    let big = [
+        v(-1e6, -1e6, 1.),
+        v(-1e6, 1e6, 1.),
+        v(1e6, 1e6, 1.),
+        v(1e6, -1e6, 1.),
+    ];
+    assert!((form_factor(DVec3::ZERO, DVec3::Z, &big) - 1.0).abs() < 1e-5);
+    // Seen from behind, nothing.
+    assert_eq!(form_factor(v(0., 0., 2.), -DVec3::Z, &sq), 0.0);
+}
+
+#[test]
+fn parallel_plates_match_closed_form() {
+    // Emitter 2×2 at height 0.7 facing down; receiver 2×2 below it facing up. The
+    // emitter is black, so nothing comes back; the receiver gets π·Le·F exactly.
+    let h = 0.7;
+    let le = v(1.0, 2.0, 0.5);
+    let emitter = quad(v(0., 0., h), DVec3::Y, DVec3::X, 0.0, le);
+    let receiver = quad(DVec3::ZERO, DVec3::X, DVec3::Y, 0.6, DVec3::ZERO);
+    let sc = scene(vec![emitter, receiver], |s| {
+        s.patch_size = 0.8;
+        s.convergence = 1e-6;
+    });
+    let (el, r) = run(&sc, 6);
+    assert_eq!(r.patches, 2 * 9);
+    let mut checked = 0;
+    for (i, x) in el.positions.iter().enumerate() {
+        if el.vertex_face[i] != 1 {
+            continue;
+        }
+        // Vertices are evaluated a hair towards their face's centre.
+        let x = *x - *x * 1e-6;
+        let (a, b) = (x.x + 1.0, x.y + 1.0);
+        let f = corner(a, b, h)
+            + corner(2.0 - a, b, h)
+            + corner(a, 2.0 - b, h)
+            + corner(2.0 - a, 2.0 - b, h);
+        let e = r.irradiance[i] / (PI * le);
+        assert!(
+            (e - DVec3::splat(f)).abs().max_element() < 1e-13,
+            "{x}: {e} vs {f}"
+        );
+        checked += 1;
+    }
+    assert!(checked > 40);
+    // Emitter first (3×3 patches), then the receiver's 9: nothing unshot is left.
+    assert_eq!(r.shots, 18);
+    assert_eq!(r.unshot_fraction, 0.0);
+}
+
+#[test]
+fn blocker_between_plates_casts_full_shadow() {
+    let h = 1.0;
+    let le = DVec3::ONE;
+    let emitter = quad(v(0., 0., h), DVec3::Y, DVec3::X, 0.0, le);
+    let receiver = quad(DVec3::ZERO, DVec3::X, DVec3::Y, 0.5, DVec3::ZERO);
+    // Facing up: it only sends light back up, the receiver sits in its shadow.
+    let blocker = quad(
+        v(0., 0., 0.5),
+        DVec3::X * 4.0,
+        DVec3::Y * 4.0,
+        0.5,
+        DVec3::ZERO,
+    );
+    let sc = scene(vec![emitter.clone(), receiver.clone(), blocker], |s| {
+        s.patch_size = 1.0
+    });
+    let (el, r) = run(&sc, 3);
+    for (i, e) in r.irradiance.iter().enumerate() {
+        match el.vertex_face[i] {
+            1 => assert_eq!(*e, DVec3::ZERO),
+            _ => assert!(e.x > 0.0),
+        }
+    }
+    // Half the blocker gone (x > 0 open): a receiver point at x0 sees the emitter where
+    // x > -x0, by similar triangles; visibility is sampled, so only roughly.
+    let half = quad(
+        v(-2.0, 0., 0.5),
+        DVec3::X * 2.0,
+        DVec3::Y * 4.0,
+        0.5,
+        DVec3::ZERO,
+    );
+    // The visible part x ∈ [x1, 1] of the emitter seen from (x0, y0), the emitter's
+    // corners at ±1 and height h.
+    let visible = |x0: f64, y0: f64, x1: f64| {
+        let (a0, a1, b0, b1) = (x1 - x0, 1.0 - x0, -1.0 - y0, 1.0 - y0);
+        let f = |a: f64, b: f64| corner(a.abs(), b.abs(), h) * a.signum() * b.signum();
+        f(a1, b1) - f(a0, b1) - f(a1, b0) + f(a0, b0)
+    };
+    let mut errors = Vec::new();
+    for rays in [16, 256] {
+        let sc = scene(vec![emitter.clone(), receiver.clone(), half.clone()], |s| {
+            s.patch_size = 0.5;
+            s.visibility_rays = rays;
+        });
+        let (el, r) = run(&sc, 3);
+        let at = |x: DVec3| {
+            r.irradiance[el
+                .positions
+                .iter()
+                .position(|p| (*p - x).length() < 1e-12)
+                .unwrap()]
+            .x / PI
+        };
+        assert_eq!(at(v(-1.0, -1.0, 0.0)), 0.0);
+        assert!(
+            (at(v(1.0, 1.0, 0.0)) / visible(1.0, 1.0, -1.0) - 1.0).abs() < 1e-4,
+            "{} {}",
+            at(v(1.0, 1.0, 0.0)),
+            visible(1.0, 1.0, -1.0)
+        );
+        let mut worst: f64 = 0.0;
+        for x0 in [-1.0 / 3.0, 1.0 / 3.0] {
+            worst =
+                worst.max((at(v(x0, 1.0 / 3.0, 0.0)) / visible(x0, 1.0 / 3.0, -x0) - 1.0).abs());
+        }
+        errors.push(worst);
+    }
+    assert!(
+        errors[0] < 0.25 && errors[1] < 0.03 && errors[1] < errors[0],
+        "{errors:?}"
+    );
+}
+
+/// The inside of the unit cube: six quads facing in, all of albedo `rho` and emission
+/// `le`, plus `extra` faces.
+fn furnace(rho: f64, le: DVec3, extra: Vec<Face>, settings: impl FnOnce(&mut Settings)) -> Scene {
+    let c = v(0.5, 0.5, 0.5);
+    let (x, y, z) = (DVec3::X * 0.5, DVec3::Y * 0.5, DVec3::Z * 0.5);
+    let mut faces = vec![
+        quad(c - z, x, y, rho, le),
+        quad(c + z, y, x, rho, le),
+        quad(c - x, y, z, rho, le),
+        quad(c + x, z, y, rho, le),
+        quad(c - y, z, x, rho, le),
+        quad(c + y, x, z, rho, le),
+    ];
+    faces.extend(extra);
+    scene(faces, settings)
+}
+
+#[test]
+fn white_furnace_gives_le_over_one_minus_rho() {
+    // Outgoing radiance L = ρE/π + Le is Le/(1−ρ) everywhere, and E = πL: so
+    // E = π·Le/(1−ρ) (all of it indirect: there are no lights).
+    let (rho, le) = (0.5, v(1.0, 0.5, 0.25));
+    let sc = furnace(rho, le, vec![], |s| {
+        s.patch_size = 0.5;
+        s.convergence = 1e-4;
+    });
+    let (_, r) = run(&sc, 4);
+    assert_eq!(r.patches, 24);
+    assert!(r.unshot_fraction < 1e-4);
+    let expect = PI * le / (1.0 - rho);
+    let mut worst: f64 = 0.0;
+    for e in &r.irradiance {
+        worst = worst.max(((*e - expect) / expect).abs().max_element());
+        assert!(e.x <= expect.x * (1.0 + 1e-9), "{e} above {expect}");
+    }
+    assert!(worst < 3e-4, "{worst}");
+
+    // Coarse convergence with the ambient term lands about as close.
+    let sc = furnace(rho, le, vec![], |s| {
+        s.patch_size = 0.5;
+        s.convergence = 0.05;
+        s.ambient = true;
+    });
+    let (_, amb) = run(&sc, 4);
+    assert!(amb.unshot_fraction > 1e-3);
+    let worst = |r: &IndirectResult| {
+        r.irradiance
+            .iter()
+            .map(|e| ((*e - expect) / expect).abs().max_element())
+            .fold(0.0, f64::max)
+    };
+    let sc = furnace(rho, le, vec![], |s| {
+        s.patch_size = 0.5;
+        s.convergence = 0.05;
+    });
+    let (_, plain) = run(&sc, 4);
+    assert!(worst(&amb) < 0.5 * worst(&plain) && worst(&amb) < amb.unshot_fraction);
+}
+
+#[test]
+fn stops_at_convergence_or_max_shots() {
+    let sc = furnace(0.7, DVec3::ONE, vec![], |s| {
+        s.patch_size = 0.5;
+        s.convergence = 0.02;
+    });
+    let (_, r) = run(&sc, 2);
+    assert!(r.unshot_fraction < 0.02 && r.unshot_fraction > 0.0);
+    let sc2 = furnace(0.7, DVec3::ONE, vec![], |s| {
+        s.patch_size = 0.5;
+        s.convergence = 0.02;
+        s.max_shots = 5;
+    });
+    let (_, r2) = run(&sc2, 2);
+    assert_eq!(r2.shots, 5);
+    assert!(r2.unshot_fraction > 0.02);
+    assert!(r.shots > 5);
+}
+
+#[test]
+fn bit_identical_for_any_thread_count() {
+    // A box with a floating plate inside, so that rays are cast.
+    let plate = quad(
+        v(0.5, 0.4, 0.45),
+        v(0.2, 0.05, 0.0),
+        v(0.0, 0.2, 0.03),
+        0.8,
+        DVec3::ZERO,
+    );
+    let sc = furnace(0.6, v(0.2, 0.3, 0.1), vec![plate], |s| {
+        s.patch_size = 0.3;
+        s.convergence = 1e-3;
+        s.visibility_rays = 9;
+    });
+    let runs: Vec<IndirectResult> = [1, 4]
+        .iter()
+        .map(|&n| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .unwrap()
+                .install(|| run(&sc, 5).1)
+        })
+        .collect();
+    assert!(runs[0].shots > 20);
+    assert_eq!(runs[0].shots, runs[1].shots);
+    let bits = |r: &IndirectResult| {
+        r.irradiance
+            .iter()
+            .flat_map(|e| e.to_array().map(f64::to_bits))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(bits(&runs[0]), bits(&runs[1]));
+    // The plate's shadow on the floor is there (points under it darker than in the open).
+    let expect = PI * 0.2 / 0.4;
+    assert!(runs[0].irradiance.iter().any(|e| e.x < 0.9 * expect));
+}
+
+#[test]
+fn cancelled_bake_stops() {
+    let sc = furnace(0.5, DVec3::ONE, vec![], |s| s.patch_size = 0.5);
+    let el = grid_elements(&sc.faces, 2);
+    let progress = Progress::new();
+    progress.cancel();
+    let r = indirect(
+        &sc,
+        &el,
+        &vec![DVec3::ZERO; el.positions.len()],
+        &Occluders::new(&sc.faces),
+        &progress,
+    );
+    assert_eq!(r, Err(BakeError::Cancelled));
+}
