@@ -13,6 +13,8 @@
 //! computed alone and added in a fixed order, so results do not depend on the thread count.
 
 use std::f64::consts::PI;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::OnceLock;
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -44,6 +46,11 @@ const FEW_RAYS_BELOW: f64 = 0.15;
 const ONE_RAY_BELOW: f64 = 0.06;
 /// Candidate occluder lists longer than this are handed to the BVH instead.
 const MAX_LISTED_OCCLUDERS: usize = 24;
+/// Per shooter face, candidate lists (for all its patches) longer than this are not kept:
+/// each patch asks the BVH for its own.
+const MAX_FACE_OCCLUDERS: usize = 512;
+/// Face ids kept in those lists over the whole bake (4 bytes each).
+const FACE_OCCLUDER_BUDGET: usize = 1 << 24;
 /// Receiver vertices per parallel work item.
 const CHUNK: usize = 256;
 
@@ -113,22 +120,17 @@ pub fn indirect(
 
         let b = std::mem::take(&mut unshot[best]);
         let faces = shooter.shoot(best, b, &mut received);
+        let touched: Vec<usize> = faces.iter().flat_map(|&f| shooter.patches_of(f)).collect();
+        let gained: Vec<DVec3> = touched
+            .par_iter()
+            .map(|&p| albedo(&patches[p]) * mean(&patches[p].weights, &received))
+            .collect();
+        for (&p, g) in touched.iter().zip(gained) {
+            unshot[p] += g;
+        }
         for f in faces {
-            let rho = scene.faces[f as usize].albedo;
             for &v in shooter.verts_of(f) {
                 irradiance[v as usize] += received[v as usize];
-            }
-            for (p, q) in patches
-                .iter()
-                .enumerate()
-                .skip(shooter.first_patch[f as usize] as usize)
-            {
-                if q.face != f {
-                    break;
-                }
-                unshot[p] += rho * mean(&q.weights, &received);
-            }
-            for &v in shooter.verts_of(f) {
                 received[v as usize] = DVec3::ZERO;
             }
         }
@@ -176,8 +178,8 @@ struct Shooter<'a> {
     /// Element vertices of face f: `face_verts[vert_start[f]..vert_start[f + 1]]`.
     vert_start: Vec<u32>,
     face_verts: Vec<u32>,
-    /// First patch of each face (patches are sorted by face).
-    first_patch: Vec<u32>,
+    /// Patches of face f: `patch_start[f]..patch_start[f + 1]` (patches are sorted by face).
+    patch_start: Vec<u32>,
     /// Faces that have element vertices.
     receivers: Vec<u32>,
     /// Vertex positions nudged into their face (see `Shooter::new`).
@@ -186,6 +188,16 @@ struct Shooter<'a> {
     /// visibility sampling.
     negligible: f64,
     tol: f64,
+    /// Per shooter face, filled on its first shot: the receiver faces that something could
+    /// stand in front of, ascending, with what (for the whole face: each patch narrows it
+    /// down). `None` inside when over the memory budget: then each patch asks the BVH.
+    face_blockers: Vec<OnceLock<Option<Vec<(u32, FaceBlockers)>>>>,
+    kept: AtomicUsize,
+}
+
+enum FaceBlockers {
+    Listed(Vec<u32>),
+    Many,
 }
 
 /// A receiver face in one shot: the shooter clipped to the face's front half-space, and
@@ -226,9 +238,12 @@ impl<'a> Shooter<'a> {
             face_verts[fill[f as usize] as usize] = v as u32;
             fill[f as usize] += 1;
         }
-        let mut first_patch = vec![patches.len() as u32; nf];
-        for (i, p) in patches.iter().enumerate().rev() {
-            first_patch[p.face as usize] = i as u32;
+        let mut patch_start = vec![0u32; nf + 1];
+        for p in patches {
+            patch_start[p.face as usize + 1] += 1;
+        }
+        for f in 0..nf {
+            patch_start[f + 1] += patch_start[f];
         }
         let receivers = (0..nf as u32)
             .filter(|&f| vert_start[f as usize + 1] > vert_start[f as usize])
@@ -266,11 +281,13 @@ impl<'a> Shooter<'a> {
             occ,
             vert_start,
             face_verts,
-            first_patch,
+            patch_start,
             receivers,
             points,
             negligible,
             tol,
+            face_blockers: (0..nf).map(|_| OnceLock::new()).collect(),
+            kept: AtomicUsize::new(0),
         }
     }
 
@@ -279,15 +296,20 @@ impl<'a> Shooter<'a> {
             [self.vert_start[f as usize] as usize..self.vert_start[f as usize + 1] as usize]
     }
 
+    fn patches_of(&self, f: u32) -> std::ops::Range<usize> {
+        self.patch_start[f as usize] as usize..self.patch_start[f as usize + 1] as usize
+    }
+
     /// Shoots radiosity `b` from patch `p`: adds each vertex's irradiance to `received`
     /// and returns the faces that got some (ascending).
     fn shoot(&self, p: usize, b: DVec3, received: &mut [DVec3]) -> Vec<u32> {
         let patch = &self.patches[p];
         let plane = self.scene.faces[patch.face as usize].plane;
+        let known = self.face_blockers(patch.face);
         let pairs: Vec<Pair> = self
             .receivers
             .par_iter()
-            .filter_map(|&f| self.pair(patch, &plane, f))
+            .filter_map(|&f| self.pair(&patch.poly, patch.face, &plane, f, known))
             .collect();
         let chunks: Vec<(usize, usize, usize)> = pairs
             .iter()
@@ -317,10 +339,46 @@ impl<'a> Shooter<'a> {
         pairs.iter().map(|p| p.face).collect()
     }
 
-    /// The shooter as receiver face `f` sees it, or `None` if no vertex of `f` can get light
-    /// from it.
-    fn pair(&self, patch: &Patch, plane: &Plane, f: u32) -> Option<Pair> {
-        if f == patch.face {
+    /// The receivers of shots from face `fp` that something could stand in front of.
+    fn face_blockers(&self, fp: u32) -> Option<&[(u32, FaceBlockers)]> {
+        let cell = self.face_blockers[fp as usize].get_or_init(|| {
+            if self.kept.load(Ordering::Relaxed) > FACE_OCCLUDER_BUDGET {
+                return None;
+            }
+            let face = &self.scene.faces[fp as usize];
+            let found: Vec<(u32, FaceBlockers)> = self
+                .receivers
+                .par_iter()
+                .filter_map(|&f| {
+                    let (lo, hi) = self.shaft(&face.verts, fp, &face.plane, f)?;
+                    let mut list = Vec::new();
+                    let planes = [face.plane, self.scene.faces[f as usize].plane];
+                    self.occ.candidates(lo, hi, &planes, &[fp, f], &mut list);
+                    match list.len() {
+                        0 => None,
+                        n if n <= MAX_FACE_OCCLUDERS => Some((f, FaceBlockers::Listed(list))),
+                        _ => Some((f, FaceBlockers::Many)),
+                    }
+                })
+                .collect();
+            let size = found.len()
+                + found
+                    .iter()
+                    .map(|(_, b)| match b {
+                        FaceBlockers::Listed(l) => l.len(),
+                        FaceBlockers::Many => 0,
+                    })
+                    .sum::<usize>();
+            self.kept.fetch_add(size, Ordering::Relaxed);
+            Some(found)
+        });
+        cell.as_deref()
+    }
+
+    /// Whether a shooter polygon `poly` on face `fp` (plane `plane`) can light receiver face
+    /// `f`, and then the box around the part of it in front of `f` and `f`.
+    fn shaft(&self, poly: &[DVec3], fp: u32, plane: &Plane, f: u32) -> Option<(DVec3, DVec3)> {
+        if f == fp {
             return None;
         }
         let face = &self.scene.faces[f as usize];
@@ -329,20 +387,49 @@ impl<'a> Shooter<'a> {
         if face.verts.iter().all(|v| plane.dist(*v) <= self.tol) {
             return None;
         }
-        let poly = clip_polygon_3d(&patch.poly, &face.plane, self.tol);
-        if poly.len() < 3 {
+        if poly.iter().all(|v| face.plane.dist(*v) <= self.tol) {
             return None;
         }
-        let inner = poly.iter().copied().sum::<DVec3>() / poly.len() as f64;
         let mut lo = DVec3::splat(f64::INFINITY);
         let mut hi = DVec3::splat(f64::NEG_INFINITY);
         for v in poly.iter().chain(&face.verts) {
             lo = lo.min(*v);
             hi = hi.max(*v);
         }
+        Some((lo, hi))
+    }
+
+    /// The shooter (patch polygon `poly` on face `fp`) as receiver face `f` sees it, or
+    /// `None` if no vertex of `f` can get light from it.
+    fn pair(
+        &self,
+        poly: &[DVec3],
+        fp: u32,
+        plane: &Plane,
+        f: u32,
+        known: Option<&[(u32, FaceBlockers)]>,
+    ) -> Option<Pair> {
+        self.shaft(poly, fp, plane, f)?;
+        let face = &self.scene.faces[f as usize];
+        let poly = clip_polygon_3d(poly, &face.plane, self.tol);
+        if poly.len() < 3 {
+            return None;
+        }
+        let inner = poly.iter().copied().sum::<DVec3>() / poly.len() as f64;
+        let (lo, hi) = self.shaft(&poly, fp, plane, f).unwrap_or((inner, inner));
         let mut list = Vec::new();
-        self.occ
-            .candidates(lo, hi, &[*plane, face.plane], &[patch.face, f], &mut list);
+        match known.map(|k| k.binary_search_by_key(&f, |e| e.0).map(|i| &k[i].1)) {
+            Some(Err(_)) => {}
+            Some(Ok(FaceBlockers::Listed(l))) => list.extend(
+                l.iter()
+                    .copied()
+                    .filter(|&o| self.occ.box_overlaps(o, lo, hi)),
+            ),
+            Some(Ok(FaceBlockers::Many)) | None => {
+                let planes = [*plane, face.plane];
+                self.occ.candidates(lo, hi, &planes, &[fp, f], &mut list);
+            }
+        }
         let vis = match list.len() {
             0 => Blockers::None,
             n if n <= MAX_LISTED_OCCLUDERS => Blockers::Listed(list),

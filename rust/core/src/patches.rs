@@ -123,8 +123,9 @@ pub fn build_patches(faces: &[Face], el: &Elements, patch_size: f64, rays: u32) 
                 .unwrap_or(0);
             cells[k].2.push(m);
         }
-        for (_, poly2, members) in cells {
-            patches.push(patch(face, f, &poly2, &members, el, rays));
+        for (cell, poly2, members) in cells {
+            let seed = (face as u64) << 40 ^ cell.1 << 20 ^ cell.0;
+            patches.push(patch(face, f, &poly2, &members, el, rays, seed));
         }
         start = end;
     }
@@ -225,6 +226,7 @@ fn patch(
     members: &[(u32, f64)],
     el: &Elements,
     rays: u32,
+    seed: u64,
 ) -> Patch {
     let area = signed_area_2d(poly2);
     let c2 = centroid_2d(poly2);
@@ -261,8 +263,8 @@ fn patch(
     let to3 = |v: Vec<DVec2>| v.into_iter().map(|p| f.frame.to_3d(p)).collect::<Vec<_>>();
     let samples = [
         vec![centroid],
-        to3(stratified(poly2, c2, 4.min(rays))),
-        to3(stratified(poly2, c2, rays)),
+        to3(stratified(poly2, c2, 4.min(rays), seed)),
+        to3(stratified(poly2, c2, rays, seed)),
     ];
     Patch {
         face,
@@ -294,7 +296,7 @@ fn centroid_2d(poly: &[DVec2]) -> DVec2 {
 /// About `n` points spread evenly over a convex polygon: centres of a square grid over its
 /// bounds, refined until `n` fall inside, then every k-th of them. Deterministic, so a bake
 /// repeats exactly.
-fn stratified(poly: &[DVec2], centroid: DVec2, n: u32) -> Vec<DVec2> {
+fn stratified(poly: &[DVec2], centroid: DVec2, n: u32, seed: u64) -> Vec<DVec2> {
     let n = n.max(1) as usize;
     if n == 1 {
         return vec![centroid];
@@ -325,8 +327,12 @@ fn stratified(poly: &[DVec2], centroid: DVec2, n: u32) -> Vec<DVec2> {
         };
         for j in 0..my {
             for i in 0..mx {
+                // Jittered within the cell (seeded, so repeatable): a regular grid would
+                // alias with regular occluders such as slats or railings.
+                let h = mix(seed ^ (j as u64) << 32 ^ i as u64 ^ (mx as u64) << 52);
+                let (jx, jy) = (0.1 + 0.8 * unit(h), 0.1 + 0.8 * unit(mix(h)));
                 let p = lo
-                    + size * DVec2::new((i as f64 + 0.5) / mx as f64, (j as f64 + 0.5) / my as f64);
+                    + size * DVec2::new((i as f64 + jx) / mx as f64, (j as f64 + jy) / my as f64);
                 if strictly_inside_convex(poly, p) {
                     inside.push(p);
                 }
@@ -344,6 +350,18 @@ fn stratified(poly: &[DVec2], centroid: DVec2, n: u32) -> Vec<DVec2> {
         return inside;
     }
     (0..n).map(|k| inside[k * inside.len() / n]).collect()
+}
+
+/// SplitMix64's finaliser: a cheap, well-spread hash.
+fn mix(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+fn unit(h: u64) -> f64 {
+    (h >> 11) as f64 / (1u64 << 53) as f64
 }
 
 #[cfg(test)]

@@ -262,6 +262,13 @@ impl Occluders {
         ))
     }
 
+    /// Whether face `id`'s bounds overlap the box `lo`–`hi` (both grown by the padding):
+    /// narrows a list from [`candidates`](Self::candidates) down to a smaller box.
+    pub fn box_overlaps(&self, id: u32, lo: DVec3, hi: DVec3) -> bool {
+        let f = &self.faces[id as usize];
+        (f.lo - self.pad).cmple(hi + self.pad).all() && (f.hi + self.pad).cmpge(lo - self.pad).all()
+    }
+
     fn face_crosses_segment(&self, id: u32, a: DVec3, b: DVec3) -> bool {
         let f = &self.faces[id as usize];
         if f.edges.is_empty() {

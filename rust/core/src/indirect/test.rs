@@ -322,6 +322,66 @@ fn bit_identical_for_any_thread_count() {
 }
 
 #[test]
+fn many_occluders_go_through_the_bvh() {
+    // Eighty overlapping slats in one plane (more than a shot lists by hand) close the gap
+    // between the plates: not a ray gets through. With every other slat gone, light does.
+    let h = 1.0;
+    let emitter = quad(v(0., 0., h), DVec3::Y, DVec3::X, 0.0, DVec3::ONE);
+    let receiver = quad(DVec3::ZERO, DVec3::X, DVec3::Y, 0.5, DVec3::ZERO);
+    let slat = |i: usize| {
+        let x = -2.0 + 0.05 * i as f64;
+        quad(
+            v(x, 0.0, 0.5),
+            v(0.03, 0.0, 0.0),
+            v(0.0, 2.0, 0.0),
+            0.5,
+            DVec3::ZERO,
+        )
+    };
+    let closed: Vec<Face> = [emitter.clone(), receiver.clone()]
+        .into_iter()
+        .chain((0..80).map(slat))
+        .collect();
+    let (el, r) = run(&scene(closed, |s| s.patch_size = 0.5), 3);
+    let on_receiver = |r: &IndirectResult| {
+        r.irradiance
+            .iter()
+            .zip(&el.vertex_face)
+            .filter(|(_, f)| **f == 1)
+            .map(|(e, _)| e.x)
+            .collect::<Vec<_>>()
+    };
+    assert!(on_receiver(&r).iter().all(|e| *e == 0.0));
+    let open: Vec<Face> = [emitter, receiver]
+        .into_iter()
+        .chain((0..80).step_by(2).map(slat))
+        .collect();
+    let (_, r) = run(&scene(open, |s| s.patch_size = 0.5), 3);
+    // Slats 0.06 wide every 0.1 in a plane halfway up hide 60% of the emitter, whatever
+    // the direction: 40% of the unblocked π·Le·F gets through.
+    // Sixteen rays to a patch sample the slats coarsely: each vertex within 25%, their mean
+    // closer.
+    let receiver_points = el
+        .positions
+        .iter()
+        .zip(&el.vertex_face)
+        .filter(|(_, f)| **f == 1);
+    let mut ratios = Vec::new();
+    for (e, (x, _)) in on_receiver(&r).iter().zip(receiver_points) {
+        let x = *x - *x * 1e-6;
+        let (a, b) = (x.x + 1.0, x.y + 1.0);
+        let f = corner(a, b, h)
+            + corner(2.0 - a, b, h)
+            + corner(a, 2.0 - b, h)
+            + corner(2.0 - a, 2.0 - b, h);
+        ratios.push(e / (PI * f));
+    }
+    assert!(ratios.iter().all(|r| (r - 0.4).abs() < 0.1), "{ratios:?}");
+    let mean = ratios.iter().sum::<f64>() / ratios.len() as f64;
+    assert!((mean - 0.4).abs() < 0.03, "{mean}");
+}
+
+#[test]
 fn cancelled_bake_stops() {
     let sc = furnace(0.5, DVec3::ONE, vec![], |s| s.patch_size = 0.5);
     let el = grid_elements(&sc.faces, 2);
@@ -335,4 +395,106 @@ fn cancelled_bake_stops() {
         &progress,
     );
     assert_eq!(r, Err(BakeError::Cancelled));
+}
+
+/// The target scene of the brief: a 32×16 UV sphere floating over an 8 m floor, lit by a
+/// sun (direct light computed here with shadow rays). Prints sizes and timings; run with
+/// `cargo test --release -p penumbra target_scene -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn target_scene_timing() {
+    let (rings, segs, r, c) = (16, 32, 1.0, v(0.0, 0.0, 1.2));
+    let at = |i: usize, j: usize| {
+        let (th, ph) = (
+            PI * i as f64 / rings as f64,
+            2.0 * PI * j as f64 / segs as f64,
+        );
+        c + v(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()) * r
+    };
+    let mut faces = vec![quad(
+        DVec3::ZERO,
+        DVec3::X * 4.0,
+        DVec3::Y * 4.0,
+        0.8,
+        DVec3::ZERO,
+    )];
+    for i in 0..rings {
+        for j in 0..segs {
+            let (a, b, cc, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+            let poly = match i {
+                0 => vec![a, b, cc],
+                _ if i == rings - 1 => vec![a, b, d],
+                _ => vec![a, b, cc, d],
+            };
+            faces.push(face(&poly, DVec3::splat(0.8), DVec3::ZERO));
+        }
+    }
+    let sc = scene(faces, |s| {
+        s.patch_size = 0.2;
+        s.convergence = 1e-3;
+    });
+    let el = grid_elements(&sc.faces, 2);
+    // The floor gets finer elements, as the mesher would give it near the shadow.
+    let floor = grid_elements(&sc.faces[..1], 70);
+    let el = {
+        let mut e = floor;
+        let off = e.positions.len() as u32;
+        for (i, f) in el.vertex_face.iter().enumerate() {
+            if *f != 0 {
+                e.positions.push(el.positions[i]);
+                e.normals.push(el.normals[i]);
+                e.vertex_face.push(*f);
+            }
+        }
+        let first = el.vertex_face.iter().position(|f| *f != 0).unwrap() as u32;
+        for (t, tri) in el.triangles.iter().enumerate() {
+            if el.tri_face[t] != 0 {
+                e.triangles.push(tri.map(|v| v - first + off));
+                e.tri_face.push(el.tri_face[t]);
+                e.tri_region.push(0);
+            }
+        }
+        e
+    };
+    let t0 = std::time::Instant::now();
+    let occ = Occluders::new(&sc.faces);
+    let sun = v(0.3, 0.2, -1.0).normalize();
+    let direct: Vec<DVec3> = el
+        .positions
+        .iter()
+        .zip(&el.normals)
+        .map(|(x, n)| {
+            let cos = -n.dot(sun);
+            if cos > 0.0 && !occ.ray_blocked(*x, -sun) {
+                DVec3::splat(3.0 * cos)
+            } else {
+                DVec3::ZERO
+            }
+        })
+        .collect();
+    let t1 = std::time::Instant::now();
+    let r = indirect(&sc, &el, &direct, &occ, &Progress::new()).unwrap();
+    let t2 = std::time::Instant::now();
+    eprintln!(
+        "faces {} vertices {} triangles {} patches {} shots {} unshot {:.2e}; bvh+direct {:.3}s indirect {:.3}s ({} threads)",
+        sc.faces.len(),
+        el.positions.len(),
+        el.triangles.len(),
+        r.patches,
+        r.shots,
+        r.unshot_fraction,
+        (t1 - t0).as_secs_f64(),
+        (t2 - t1).as_secs_f64(),
+        rayon::current_num_threads()
+    );
+    let floor_mean = r
+        .irradiance
+        .iter()
+        .zip(&el.vertex_face)
+        .filter(|(_, f)| **f == 0)
+        .map(|(e, _)| e.x)
+        .sum::<f64>()
+        / el.vertex_face.iter().filter(|f| **f == 0).count() as f64;
+    eprintln!("mean indirect irradiance on the floor {floor_mean:.4} W/m²");
+    assert!(r.unshot_fraction < 1e-3);
 }
