@@ -123,6 +123,7 @@ pub fn indirect(
         let touched: Vec<usize> = faces.iter().flat_map(|&f| shooter.patches_of(f)).collect();
         let gained: Vec<DVec3> = touched
             .par_iter()
+            .with_min_len(64)
             .map(|&p| albedo(&patches[p]) * mean(&patches[p].weights, &received))
             .collect();
         for (&p, g) in touched.iter().zip(gained) {
@@ -175,9 +176,15 @@ struct Shooter<'a> {
     el: &'a Elements,
     patches: &'a [Patch],
     occ: &'a Occluders,
-    /// Element vertices of face f: `face_verts[vert_start[f]..vert_start[f + 1]]`.
+    /// Element vertices of face f: `face_verts[vert_start[f]..vert_start[f + 1]]`, ordered
+    /// by group.
     vert_start: Vec<u32>,
     face_verts: Vec<u32>,
+    /// Groups of nearby vertices of face f (one per patch of f):
+    /// `groups[group_start[f]..group_start[f + 1]]`. Occluders are looked for between a
+    /// shooter and each group: the box around a whole floor would hold everything in a room.
+    group_start: Vec<u32>,
+    groups: Vec<Group>,
     /// Patches of face f: `patch_start[f]..patch_start[f + 1]` (patches are sorted by face).
     patch_start: Vec<u32>,
     /// Faces that have element vertices.
@@ -195,6 +202,14 @@ struct Shooter<'a> {
     kept: AtomicUsize,
 }
 
+/// Vertices `face_verts[start..end]` and their bounds.
+struct Group {
+    start: u32,
+    end: u32,
+    lo: DVec3,
+    hi: DVec3,
+}
+
 enum FaceBlockers {
     Listed(Vec<u32>),
     Many,
@@ -202,12 +217,17 @@ enum FaceBlockers {
 
 /// A receiver face in one shot: the shooter clipped to the face's front half-space, and
 /// which faces could block the rays between them.
-struct Pair {
+struct Pair<'s> {
     face: u32,
     poly: Vec<DVec3>,
+    /// Bounds of `poly`.
+    lo: DVec3,
+    hi: DVec3,
     /// A point of `poly`, for when no sample of the patch lies in front of the face.
     inner: DVec3,
-    vis: Blockers,
+    /// `None`: nothing can block. `Some(Some(list))`: only these (for the whole face).
+    /// `Some(None)`: ask the BVH.
+    known: Option<Option<&'s [u32]>>,
 }
 
 enum Blockers {
@@ -232,18 +252,51 @@ impl<'a> Shooter<'a> {
         for f in 0..nf {
             vert_start[f + 1] += vert_start[f];
         }
-        let mut fill = vert_start.clone();
-        let mut face_verts = vec![0u32; el.vertex_face.len()];
-        for (v, &f) in el.vertex_face.iter().enumerate() {
-            face_verts[fill[f as usize] as usize] = v as u32;
-            fill[f as usize] += 1;
-        }
         let mut patch_start = vec![0u32; nf + 1];
         for p in patches {
             patch_start[p.face as usize + 1] += 1;
         }
         for f in 0..nf {
             patch_start[f + 1] += patch_start[f];
+        }
+        // Each vertex joins the group of the first patch it weighs in; vertices in no patch
+        // (in no triangle) form one last group of their face.
+        let mut group_of = vec![u32::MAX; el.positions.len()];
+        for (i, p) in patches.iter().enumerate() {
+            for &(v, _) in &p.weights {
+                if group_of[v as usize] == u32::MAX {
+                    group_of[v as usize] = i as u32;
+                }
+            }
+        }
+        let mut order: Vec<u32> = (0..el.positions.len() as u32).collect();
+        order.sort_by_key(|&v| (el.vertex_face[v as usize], group_of[v as usize], v));
+        let mut face_verts = Vec::with_capacity(order.len());
+        let mut groups: Vec<Group> = Vec::new();
+        let mut group_start = vec![0u32; nf + 1];
+        for (k, &v) in order.iter().enumerate() {
+            let x = el.positions[v as usize];
+            let f = el.vertex_face[v as usize];
+            let new_group = k == 0
+                || el.vertex_face[order[k - 1] as usize] != f
+                || group_of[order[k - 1] as usize] != group_of[v as usize];
+            if new_group {
+                groups.push(Group {
+                    start: k as u32,
+                    end: k as u32,
+                    lo: x,
+                    hi: x,
+                });
+                group_start[f as usize + 1] += 1;
+            }
+            let g = groups.last_mut().expect("a group was opened");
+            g.end += 1;
+            g.lo = g.lo.min(x);
+            g.hi = g.hi.max(x);
+            face_verts.push(v);
+        }
+        for f in 0..nf {
+            group_start[f + 1] += group_start[f];
         }
         let receivers = (0..nf as u32)
             .filter(|&f| vert_start[f as usize + 1] > vert_start[f as usize])
@@ -281,6 +334,8 @@ impl<'a> Shooter<'a> {
             occ,
             vert_start,
             face_verts,
+            group_start,
+            groups,
             patch_start,
             receivers,
             points,
@@ -309,30 +364,50 @@ impl<'a> Shooter<'a> {
         let pairs: Vec<Pair> = self
             .receivers
             .par_iter()
+            .with_min_len(32)
             .filter_map(|&f| self.pair(&patch.poly, patch.face, &plane, f, known))
             .collect();
-        let chunks: Vec<(usize, usize, usize)> = pairs
-            .iter()
-            .enumerate()
-            .flat_map(|(k, pair)| {
-                let n = self.verts_of(pair.face).len();
-                (0..n)
-                    .step_by(CHUNK)
-                    .map(move |s| (k, s, (s + CHUNK).min(n)))
-            })
-            .collect();
+        // Work items: runs of whole groups of one face, about CHUNK vertices each.
+        let mut chunks: Vec<(usize, usize, usize)> = Vec::new();
+        for (k, pair) in pairs.iter().enumerate() {
+            let (g0, g1) = (
+                self.group_start[pair.face as usize] as usize,
+                self.group_start[pair.face as usize + 1] as usize,
+            );
+            let mut first = g0;
+            let mut count = 0;
+            for g in g0..g1 {
+                count += (self.groups[g].end - self.groups[g].start) as usize;
+                if count >= CHUNK || g + 1 == g1 {
+                    chunks.push((k, first, g + 1));
+                    first = g + 1;
+                    count = 0;
+                }
+            }
+        }
         let values: Vec<Vec<DVec3>> = chunks
             .par_iter()
-            .map(|&(k, s, e)| {
+            .map(|&(k, g0, g1)| {
                 let pair = &pairs[k];
-                self.verts_of(pair.face)[s..e]
-                    .iter()
-                    .map(|&v| self.receive(patch, &plane, pair, v, b))
-                    .collect()
+                let mut out = Vec::new();
+                for group in &self.groups[g0..g1] {
+                    let blockers = self.blockers(patch.face, &plane, pair, group);
+                    let verts = &self.face_verts[group.start as usize..group.end as usize];
+                    out.extend(
+                        verts
+                            .iter()
+                            .map(|&v| self.receive(patch, &plane, pair, &blockers, v, b)),
+                    );
+                }
+                out
             })
             .collect();
-        for (&(k, s, _), vals) in chunks.iter().zip(values) {
-            for (&v, e) in self.verts_of(pairs[k].face)[s..].iter().zip(vals) {
+        for (&(_, g0, g1), vals) in chunks.iter().zip(values) {
+            let (s, e) = (
+                self.groups[g0].start as usize,
+                self.groups[g1 - 1].end as usize,
+            );
+            for (&v, e) in self.face_verts[s..e].iter().zip(vals) {
                 received[v as usize] = e;
             }
         }
@@ -401,14 +476,14 @@ impl<'a> Shooter<'a> {
 
     /// The shooter (patch polygon `poly` on face `fp`) as receiver face `f` sees it, or
     /// `None` if no vertex of `f` can get light from it.
-    fn pair(
+    fn pair<'s>(
         &self,
         poly: &[DVec3],
         fp: u32,
         plane: &Plane,
         f: u32,
-        known: Option<&[(u32, FaceBlockers)]>,
-    ) -> Option<Pair> {
+        known: Option<&'s [(u32, FaceBlockers)]>,
+    ) -> Option<Pair<'s>> {
         self.shaft(poly, fp, plane, f)?;
         let face = &self.scene.faces[f as usize];
         let poly = clip_polygon_3d(poly, &face.plane, self.tol);
@@ -416,35 +491,63 @@ impl<'a> Shooter<'a> {
             return None;
         }
         let inner = poly.iter().copied().sum::<DVec3>() / poly.len() as f64;
-        let (lo, hi) = self.shaft(&poly, fp, plane, f).unwrap_or((inner, inner));
-        let mut list = Vec::new();
-        match known.map(|k| k.binary_search_by_key(&f, |e| e.0).map(|i| &k[i].1)) {
-            Some(Err(_)) => {}
-            Some(Ok(FaceBlockers::Listed(l))) => list.extend(
-                l.iter()
-                    .copied()
-                    .filter(|&o| self.occ.box_overlaps(o, lo, hi)),
-            ),
-            Some(Ok(FaceBlockers::Many)) | None => {
-                let planes = [*plane, face.plane];
-                self.occ.candidates(lo, hi, &planes, &[fp, f], &mut list);
-            }
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        for v in &poly {
+            lo = lo.min(*v);
+            hi = hi.max(*v);
         }
-        let vis = match list.len() {
-            0 => Blockers::None,
-            n if n <= MAX_LISTED_OCCLUDERS => Blockers::Listed(list),
-            _ => Blockers::Any,
+        let known = match known.map(|k| k.binary_search_by_key(&f, |e| e.0).map(|i| &k[i].1)) {
+            Some(Err(_)) => None,
+            Some(Ok(FaceBlockers::Listed(l))) => Some(Some(&l[..])),
+            Some(Ok(FaceBlockers::Many)) | None => Some(None),
         };
         Some(Pair {
             face: f,
             poly,
+            lo,
+            hi,
             inner,
-            vis,
+            known,
         })
     }
 
+    /// What could stand between the shooter and the vertices of `group`.
+    fn blockers(&self, fp: u32, plane: &Plane, pair: &Pair, group: &Group) -> Blockers {
+        let Some(known) = pair.known else {
+            return Blockers::None;
+        };
+        let (lo, hi) = (pair.lo.min(group.lo), pair.hi.max(group.hi));
+        let mut list = Vec::new();
+        match known {
+            Some(l) => list.extend(
+                l.iter()
+                    .copied()
+                    .filter(|&o| self.occ.box_overlaps(o, lo, hi)),
+            ),
+            None => {
+                let planes = [*plane, self.scene.faces[pair.face as usize].plane];
+                self.occ
+                    .candidates(lo, hi, &planes, &[fp, pair.face], &mut list);
+            }
+        }
+        match list.len() {
+            0 => Blockers::None,
+            n if n <= MAX_LISTED_OCCLUDERS => Blockers::Listed(list),
+            _ => Blockers::Any,
+        }
+    }
+
     /// Irradiance at vertex `v` from the shooter.
-    fn receive(&self, patch: &Patch, plane: &Plane, pair: &Pair, v: u32, b: DVec3) -> DVec3 {
+    fn receive(
+        &self,
+        patch: &Patch,
+        plane: &Plane,
+        pair: &Pair,
+        blockers: &Blockers,
+        v: u32,
+        b: DVec3,
+    ) -> DVec3 {
         let x = self.points[v as usize];
         if plane.dist(x) <= self.tol {
             return DVec3::ZERO;
@@ -455,7 +558,7 @@ impl<'a> Shooter<'a> {
             return DVec3::ZERO;
         }
         let e = b * ff;
-        let vis = match &pair.vis {
+        let vis = match blockers {
             Blockers::None => 1.0,
             blockers => {
                 let size = patch.radius / (patch.centroid - x).length();

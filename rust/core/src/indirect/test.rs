@@ -397,13 +397,8 @@ fn cancelled_bake_stops() {
     assert_eq!(r, Err(BakeError::Cancelled));
 }
 
-/// The target scene of the brief: a 32×16 UV sphere floating over an 8 m floor, lit by a
-/// sun (direct light computed here with shadow rays). Prints sizes and timings; run with
-/// `cargo test --release -p penumbra target_scene -- --ignored --nocapture`.
-#[test]
-#[ignore]
-fn target_scene_timing() {
-    let (rings, segs, r, c) = (16, 32, 1.0, v(0.0, 0.0, 1.2));
+/// A UV sphere of `rings` × `segs` faces.
+fn uv_sphere(rings: usize, segs: usize, r: f64, c: DVec3, albedo: f64) -> Vec<Face> {
     let at = |i: usize, j: usize| {
         let (th, ph) = (
             PI * i as f64 / rings as f64,
@@ -411,13 +406,7 @@ fn target_scene_timing() {
         );
         c + v(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()) * r
     };
-    let mut faces = vec![quad(
-        DVec3::ZERO,
-        DVec3::X * 4.0,
-        DVec3::Y * 4.0,
-        0.8,
-        DVec3::ZERO,
-    )];
+    let mut faces = Vec::new();
     for i in 0..rings {
         for j in 0..segs {
             let (a, b, cc, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
@@ -426,47 +415,52 @@ fn target_scene_timing() {
                 _ if i == rings - 1 => vec![a, b, d],
                 _ => vec![a, b, cc, d],
             };
-            faces.push(face(&poly, DVec3::splat(0.8), DVec3::ZERO));
+            faces.push(face(&poly, DVec3::splat(albedo), DVec3::ZERO));
         }
     }
+    faces
+}
+
+/// Elements about `size` across on every face, direct light from a point light at `light`
+/// (shadow rays), then the indirect stage, timed.
+fn time_scene(name: &str, faces: Vec<Face>, size: f64, light: DVec3) -> IndirectResult {
     let sc = scene(faces, |s| {
-        s.patch_size = 0.2;
+        s.patch_size = 2.0 * size;
         s.convergence = 1e-3;
     });
-    let el = grid_elements(&sc.faces, 2);
-    // The floor gets finer elements, as the mesher would give it near the shadow.
-    let floor = grid_elements(&sc.faces[..1], 70);
-    let el = {
-        let mut e = floor;
-        let off = e.positions.len() as u32;
-        for (i, f) in el.vertex_face.iter().enumerate() {
-            if *f != 0 {
-                e.positions.push(el.positions[i]);
-                e.normals.push(el.normals[i]);
-                e.vertex_face.push(*f);
-            }
-        }
-        let first = el.vertex_face.iter().position(|f| *f != 0).unwrap() as u32;
-        for (t, tri) in el.triangles.iter().enumerate() {
-            if el.tri_face[t] != 0 {
-                e.triangles.push(tri.map(|v| v - first + off));
-                e.tri_face.push(el.tri_face[t]);
-                e.tri_region.push(0);
-            }
-        }
-        e
-    };
+    let mut el = Elements::default();
+    for (i, f) in sc.faces.iter().enumerate() {
+        let reach = f
+            .verts
+            .iter()
+            .map(|v| (*v - f.verts[0]).length())
+            .fold(0.0, f64::max);
+        let mut one = grid_elements(
+            std::slice::from_ref(f),
+            (reach / size).ceil().max(1.0) as usize,
+        );
+        let off = el.positions.len() as u32;
+        one.vertex_face.iter_mut().for_each(|x| *x = i as u32);
+        one.tri_face.iter_mut().for_each(|x| *x = i as u32);
+        el.positions.extend(one.positions);
+        el.normals.extend(one.normals);
+        el.vertex_face.extend(one.vertex_face);
+        el.triangles
+            .extend(one.triangles.iter().map(|t| t.map(|v| v + off)));
+        el.tri_face.extend(one.tri_face);
+        el.tri_region.extend(one.tri_region);
+    }
     let t0 = std::time::Instant::now();
     let occ = Occluders::new(&sc.faces);
-    let sun = v(0.3, 0.2, -1.0).normalize();
     let direct: Vec<DVec3> = el
         .positions
         .iter()
         .zip(&el.normals)
         .map(|(x, n)| {
-            let cos = -n.dot(sun);
-            if cos > 0.0 && !occ.ray_blocked(*x, -sun) {
-                DVec3::splat(3.0 * cos)
+            let d = light - *x;
+            let cos = n.dot(d) / d.length();
+            if cos > 0.0 && !occ.segment_blocked(*x, light) {
+                DVec3::splat(10.0 * cos / d.length_squared())
             } else {
                 DVec3::ZERO
             }
@@ -476,10 +470,9 @@ fn target_scene_timing() {
     let r = indirect(&sc, &el, &direct, &occ, &Progress::new()).unwrap();
     let t2 = std::time::Instant::now();
     eprintln!(
-        "faces {} vertices {} triangles {} patches {} shots {} unshot {:.2e}; bvh+direct {:.3}s indirect {:.3}s ({} threads)",
+        "{name}: faces {} vertices {} patches {} shots {} unshot {:.2e}; bvh+direct {:.3}s indirect {:.3}s ({} threads)",
         sc.faces.len(),
         el.positions.len(),
-        el.triangles.len(),
         r.patches,
         r.shots,
         r.unshot_fraction,
@@ -487,14 +480,51 @@ fn target_scene_timing() {
         (t2 - t1).as_secs_f64(),
         rayon::current_num_threads()
     );
-    let floor_mean = r
-        .irradiance
-        .iter()
-        .zip(&el.vertex_face)
-        .filter(|(_, f)| **f == 0)
-        .map(|(e, _)| e.x)
-        .sum::<f64>()
-        / el.vertex_face.iter().filter(|f| **f == 0).count() as f64;
-    eprintln!("mean indirect irradiance on the floor {floor_mean:.4} W/m²");
     assert!(r.unshot_fraction < 1e-3);
+    r
+}
+
+/// The target scene of the brief (a 32×16 UV sphere over a floor), and (`room_timing`) a
+/// closed room with a sphere and a box in it, where rays are needed. Print sizes and
+/// timings; run with `cargo test --release -p penumbra timing -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn scene_timing() {
+    let light = v(2.0, 1.0, 4.0);
+    let mut faces = vec![quad(
+        DVec3::ZERO,
+        DVec3::X * 4.0,
+        DVec3::Y * 4.0,
+        0.8,
+        DVec3::ZERO,
+    )];
+    faces.extend(uv_sphere(16, 32, 1.0, v(0.0, 0.0, 1.2), 0.8));
+    time_scene("sphere over floor", faces, 0.1, light);
+}
+
+#[test]
+#[ignore]
+fn room_timing() {
+    let c = v(0.0, 0.0, 1.5);
+    let (x, y, z) = (DVec3::X * 2.5, DVec3::Y * 2.5, DVec3::Z * 1.5);
+    let mut room = vec![
+        quad(c - z, x, y, 0.7, DVec3::ZERO),
+        quad(c + z, y, x, 0.7, DVec3::ZERO),
+        quad(c - x, y, z, 0.6, DVec3::ZERO),
+        quad(c + x, z, y, 0.6, DVec3::ZERO),
+        quad(c - y, z, x, 0.6, DVec3::ZERO),
+        quad(c + y, x, z, 0.6, DVec3::ZERO),
+    ];
+    room.extend(uv_sphere(16, 32, 0.7, v(-0.8, 0.3, 0.9), 0.8));
+    // A box on the floor: its faces outwards.
+    let b = v(1.1, -0.6, 0.5);
+    let (bx, by, bz) = (DVec3::X * 0.5, DVec3::Y * 0.5, DVec3::Z * 0.5);
+    room.extend([
+        quad(b + bz, bx, by, 0.5, DVec3::ZERO),
+        quad(b - bx, bz, by, 0.5, DVec3::ZERO),
+        quad(b + bx, by, bz, 0.5, DVec3::ZERO),
+        quad(b - by, bx, bz, 0.5, DVec3::ZERO),
+        quad(b + by, bz, bx, 0.5, DVec3::ZERO),
+    ]);
+    time_scene("room with sphere and box", room, 0.12, v(0.3, 0.2, 2.9));
 }
