@@ -47,8 +47,9 @@ const ONE_RAY_BELOW: f64 = 0.06;
 /// Candidate occluder lists longer than this are handed to the BVH instead.
 const MAX_LISTED_OCCLUDERS: usize = 24;
 /// Per shooter face, candidate lists (for all its patches) longer than this are not kept:
-/// each patch asks the BVH for its own.
-const MAX_FACE_OCCLUDERS: usize = 512;
+/// each group of receiver vertices asks the BVH for its own, which beats sifting a long
+/// list once per group.
+const MAX_FACE_OCCLUDERS: usize = 64;
 /// Face ids kept in those lists over the whole bake (4 bytes each).
 const FACE_OCCLUDER_BUDGET: usize = 1 << 24;
 /// Receiver vertices per parallel work item.

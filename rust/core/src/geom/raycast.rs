@@ -193,7 +193,7 @@ impl Occluders {
         })
     }
 
-    /// Appends to `out` (sorted) every face that could cross a segment lying inside the box
+    /// Appends to `out` (in no set order) every face that could cross a segment lying inside the box
     /// `lo`–`hi` and in front of (or on) each of `planes`: those whose box overlaps it and
     /// which are not wholly behind one of the planes. A face wholly behind a plane can meet
     /// such a segment only on that plane, which is where its ends are, and ends never block.
@@ -206,7 +206,6 @@ impl Occluders {
         out: &mut Vec<u32>,
     ) {
         let Some(bvh) = &self.bvh else { return };
-        let start = out.len();
         let query = Aabb::new(
             to_f32(lo - self.centre - self.pad),
             to_f32(hi - self.centre + self.pad),
@@ -231,7 +230,6 @@ impl Occluders {
             }
             true
         });
-        out[start..].sort_unstable();
     }
 
     /// The `f32` ray for the part of `o + t·dir`, `t ∈ [0, len]`, inside the scene's bounds:
@@ -513,6 +511,7 @@ pub(crate) mod test {
         let o = two();
         let mut out = Vec::new();
         o.candidates(v(-1., -1., -1.), v(3., 1., 1.), &[], &[], &mut out);
+        out.sort_unstable();
         assert_eq!(out, vec![0, 1]);
         out.clear();
         // Segments in front of the plane x = 1 (facing +x) can only meet the wall.
