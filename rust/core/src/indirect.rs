@@ -6,10 +6,11 @@
 //! `emission` is radiance, so it leaves the face as radiosity π·Le.
 //!
 //! Form factors are exact point-to-polygon integrals (Lambert's formula) times a visible
-//! fraction from rays to stratified points on the patch. Most pairs need no rays: a face
-//! can only be in the way if it pokes out in front of both the shooter's and the receiver's
-//! planes inside the box around them ([`Occluders::candidates`]), which for convex objects
-//! and floors is never. Shots are parallel over receiver vertices; each vertex's value is
+//! fraction from rays to stratified points on the patch, each ray weighted by its own
+//! point-to-point form factor. Most pairs need no rays: a face can only be in the way if it
+//! pokes out in front of both the shooter's and the receiver's planes inside the box around
+//! the shooter and a group of receiver vertices ([`Occluders::candidates`]), which for
+//! convex objects and floors is never. Rays to far patches are fewer (1 or ~4). Shots are parallel over receiver vertices; each vertex's value is
 //! computed alone and added in a fixed order, so results do not depend on the thread count.
 
 use std::f64::consts::PI;
@@ -52,6 +53,8 @@ const MAX_LISTED_OCCLUDERS: usize = 24;
 const MAX_FACE_OCCLUDERS: usize = 64;
 /// Face ids kept in those lists over the whole bake (4 bytes each).
 const FACE_OCCLUDER_BUDGET: usize = 1 << 24;
+/// Form factors kept for repeat shots, over the whole bake (4 bytes each).
+const FACTOR_BUDGET: usize = 1 << 25;
 /// Receiver vertices per parallel work item.
 const CHUNK: usize = 256;
 
@@ -201,6 +204,11 @@ struct Shooter<'a> {
     /// down). `None` inside when over the memory budget: then each patch asks the BVH.
     face_blockers: Vec<OnceLock<Option<Vec<(u32, FaceBlockers)>>>>,
     kept: AtomicUsize,
+    /// Per patch, after its first shot: the faces it reached and each of their vertices'
+    /// form factor times visibility. A patch shoots again whenever light came back to it
+    /// (in a closed room, many times), and the geometry has not changed.
+    factors: Vec<OnceLock<(Vec<u32>, Vec<f32>)>>,
+    factors_kept: AtomicUsize,
 }
 
 /// Vertices `face_verts[start..end]` and their bounds.
@@ -344,6 +352,8 @@ impl<'a> Shooter<'a> {
             tol,
             face_blockers: (0..nf).map(|_| OnceLock::new()).collect(),
             kept: AtomicUsize::new(0),
+            factors: (0..patches.len()).map(|_| OnceLock::new()).collect(),
+            factors_kept: AtomicUsize::new(0),
         }
     }
 
@@ -359,6 +369,13 @@ impl<'a> Shooter<'a> {
     /// Shoots radiosity `b` from patch `p`: adds each vertex's irradiance to `received`
     /// and returns the faces that got some (ascending).
     fn shoot(&self, p: usize, b: DVec3, received: &mut [DVec3]) -> Vec<u32> {
+        if let Some((faces, factors)) = self.factors[p].get() {
+            let verts = faces.iter().flat_map(|&f| self.verts_of(f));
+            for (&v, &g) in verts.zip(factors) {
+                received[v as usize] = b * g as f64;
+            }
+            return faces.clone();
+        }
         let patch = &self.patches[p];
         let plane = self.scene.faces[patch.face as usize].plane;
         let known = self.face_blockers(patch.face);
@@ -386,7 +403,7 @@ impl<'a> Shooter<'a> {
                 }
             }
         }
-        let values: Vec<Vec<DVec3>> = chunks
+        let values: Vec<Vec<f64>> = chunks
             .par_iter()
             .map(|&(k, g0, g1)| {
                 let pair = &pairs[k];
@@ -403,16 +420,23 @@ impl<'a> Shooter<'a> {
                 out
             })
             .collect();
-        for (&(_, g0, g1), vals) in chunks.iter().zip(values) {
+        for (&(_, g0, g1), vals) in chunks.iter().zip(&values) {
             let (s, e) = (
                 self.groups[g0].start as usize,
                 self.groups[g1 - 1].end as usize,
             );
-            for (&v, e) in self.face_verts[s..e].iter().zip(vals) {
-                received[v as usize] = e;
+            for (&v, g) in self.face_verts[s..e].iter().zip(vals) {
+                received[v as usize] = b * *g;
             }
         }
-        pairs.iter().map(|p| p.face).collect()
+        let faces: Vec<u32> = pairs.iter().map(|p| p.face).collect();
+        let n: usize = values.iter().map(Vec::len).sum();
+        if self.factors_kept.load(Ordering::Relaxed) + n <= FACTOR_BUDGET {
+            self.factors_kept.fetch_add(n, Ordering::Relaxed);
+            let factors = values.iter().flatten().map(|&g| g as f32).collect();
+            let _ = self.factors[p].set((faces.clone(), factors));
+        }
+        faces
     }
 
     /// The receivers of shots from face `fp` that something could stand in front of.
@@ -539,7 +563,8 @@ impl<'a> Shooter<'a> {
         }
     }
 
-    /// Irradiance at vertex `v` from the shooter.
+    /// Form factor from vertex `v` to the shooter times the fraction of it in view: the
+    /// vertex gets `b` times this. (`b` only decides how hard to look.)
     fn receive(
         &self,
         patch: &Patch,
@@ -548,15 +573,15 @@ impl<'a> Shooter<'a> {
         blockers: &Blockers,
         v: u32,
         b: DVec3,
-    ) -> DVec3 {
+    ) -> f64 {
         let x = self.points[v as usize];
         if plane.dist(x) <= self.tol {
-            return DVec3::ZERO;
+            return 0.0;
         }
         let n = self.el.normals[v as usize];
         let ff = form_factor(x, n, &pair.poly);
         if !(ff > 0.0) {
-            return DVec3::ZERO;
+            return 0.0;
         }
         let e = b * ff;
         let vis = match blockers {
@@ -597,7 +622,7 @@ impl<'a> Shooter<'a> {
                 }
             }
         };
-        e * vis
+        ff * vis
     }
 }
 
