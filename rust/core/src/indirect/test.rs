@@ -26,9 +26,12 @@ fn scene(faces: Vec<Face>, settings: impl FnOnce(&mut Settings)) -> Scene {
     let pts = faces.iter().flat_map(|f| f.verts.iter().copied());
     let lo = pts.clone().fold(DVec3::splat(f64::INFINITY), DVec3::min);
     let hi = pts.fold(DVec3::splat(f64::NEG_INFINITY), DVec3::max);
+    let n = faces.len() as u32;
     Scene {
         meshes: vec![],
         faces,
+        occluders: (0..n).map(crate::scene::solids::Occluder::Face).collect(),
+        face_occluder: (0..n).collect(),
         lights: vec![],
         settings: s,
         bounds_min: lo,
