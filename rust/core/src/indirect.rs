@@ -203,7 +203,7 @@ struct Shooter<'a> {
     /// Per shooter face, filled on its first shot: the receiver faces that something could
     /// stand in front of, ascending, with what (for the whole face: each patch narrows it
     /// down). `None` inside when over the memory budget: then each patch asks the BVH.
-    face_blockers: Vec<OnceLock<Option<Vec<(u32, FaceBlockers)>>>>,
+    face_blockers: Vec<OnceLock<Option<Vec<Reached>>>>,
     kept: AtomicUsize,
     /// Per patch, after its first shot: the faces it reached and each of their vertices'
     /// form factor times visibility. A patch shoots again whenever light came back to it
@@ -228,6 +228,9 @@ struct Group {
     lo: DVec3,
     hi: DVec3,
 }
+
+/// A receiver face and what could stand between it and a shooter face.
+type Reached = (u32, FaceBlockers);
 
 enum FaceBlockers {
     Listed(Vec<u32>),
@@ -470,13 +473,13 @@ impl<'a> Shooter<'a> {
     }
 
     /// The receivers of shots from face `fp` that something could stand in front of.
-    fn face_blockers(&self, fp: u32) -> Option<&[(u32, FaceBlockers)]> {
+    fn face_blockers(&self, fp: u32) -> Option<&[Reached]> {
         let cell = self.face_blockers[fp as usize].get_or_init(|| {
             if self.kept.load(Ordering::Relaxed) > FACE_OCCLUDER_BUDGET {
                 return None;
             }
             let face = &self.scene.faces[fp as usize];
-            let found: Vec<(u32, FaceBlockers)> = self
+            let found: Vec<Reached> = self
                 .receivers
                 .par_iter()
                 .filter_map(|&f| {
@@ -537,7 +540,7 @@ impl<'a> Shooter<'a> {
         fp: u32,
         plane: &Plane,
         f: u32,
-        known: Option<&'s [(u32, FaceBlockers)]>,
+        known: Option<&'s [Reached]>,
     ) -> Option<Pair<'s>> {
         self.shaft(poly, fp, plane, f)?;
         let face = &self.scene.faces[f as usize];
