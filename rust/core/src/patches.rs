@@ -95,7 +95,9 @@ pub fn build_patches(faces: &[Face], el: &Elements, patch_size: f64, rays: u32) 
         // element poking out of the face by rounding) hands its pieces to the nearest.
         let f = &faces[face as usize];
         let grid = &grids[face as usize];
-        let mut cells: Vec<((u64, u64), Vec<DVec2>, Vec<(u32, f64)>)> = Vec::new();
+        // (cell, the face within it, (triangle, overlap area) pairs)
+        type Cell = ((u64, u64), Vec<DVec2>, Vec<(u32, f64)>);
+        let mut cells: Vec<Cell> = Vec::new();
         let mut orphans: Vec<((u64, u64), (u32, f64))> = Vec::new();
         let mut i = start;
         while i < end {
@@ -400,8 +402,8 @@ pub(crate) mod test {
                     }
                 }
                 let n = el.triangles.len() - el.tri_face.len();
-                el.tri_face.extend(std::iter::repeat(fi as u32).take(n));
-                el.tri_region.extend(std::iter::repeat(0).take(n));
+                el.tri_face.extend(std::iter::repeat_n(fi as u32, n));
+                el.tri_region.extend(std::iter::repeat_n(0, n));
             }
         }
         el
@@ -419,7 +421,7 @@ pub(crate) mod test {
     #[test]
     fn grid_elements_cover_the_face() {
         let f = square(2.0);
-        let el = grid_elements(&[f.clone()], 5);
+        let el = grid_elements(std::slice::from_ref(&f), 5);
         let area: f64 = el
             .triangles
             .iter()
@@ -435,7 +437,7 @@ pub(crate) mod test {
     #[test]
     fn square_face_splits_into_cells_covering_it() {
         let f = square(2.0);
-        let el = grid_elements(&[f.clone()], 8);
+        let el = grid_elements(std::slice::from_ref(&f), 8);
         // 2 / 0.7 → 3 cells a side of 2/3.
         let p = build_patches(&[f], &el, 0.7, 16);
         assert_eq!(p.len(), 9);
@@ -469,8 +471,8 @@ pub(crate) mod test {
             DVec3::ONE,
             DVec3::ZERO,
         );
-        let el = grid_elements(&[f.clone()], 12);
-        let p = build_patches(&[f.clone()], &el, 1.0, 9);
+        let el = grid_elements(std::slice::from_ref(&f), 12);
+        let p = build_patches(std::slice::from_ref(&f), &el, 1.0, 9);
         let total: f64 = p.iter().map(|p| p.area).sum();
         assert!((total - 4.5).abs() < 1e-12);
         // Every patch holds elements; samples lie inside the face and on its plane.
