@@ -6,6 +6,7 @@
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
+use crate::events::critical_segments;
 use crate::geom::bvh::{Aabb, BoxTree};
 use crate::geom::polygon::{
     clip_polygon_2d, clip_polygon_3d, signed_area_2d, simplify_convex, HalfPlane,
@@ -49,6 +50,8 @@ pub struct ReceiverShadows {
     /// Occluder edges lying on the receiver (contact lines), in its frame: light jumps
     /// across them (D0), so the mesh must not share vertices there.
     pub contacts: Vec<[DVec2; 2]>,
+    /// VE/EV critical lines inside penumbrae (light index, segment), see `events`.
+    pub events: Vec<(u32, [DVec2; 2])>,
 }
 
 /// Restricts a 3-D half-space to the receiver's plane: a 2-D half-plane in its frame, or
@@ -176,6 +179,7 @@ pub fn shadow_polygons(
             exposure: vec![Exposure::Regions; scene.lights.len()],
             polys: Vec::new(),
             contacts: Vec::new(),
+            events: Vec::new(),
         })
         .collect();
 
@@ -216,7 +220,7 @@ pub fn shadow_polygons(
         stats.t_sdw += t0.elapsed().as_secs_f64();
 
         let t1 = std::time::Instant::now();
-        let results: Vec<(Exposure, Vec<ShadowPolygon>, Vec<[DVec2; 2]>)> = faces
+        let results: Vec<OnReceiver> = faces
             .par_iter()
             .enumerate()
             .map(|(ri, r)| {
@@ -232,10 +236,13 @@ pub fn shadow_polygons(
                 )
             })
             .collect();
-        for (ri, (exp, polys, contacts)) in results.into_iter().enumerate() {
-            per_receiver[ri].exposure[li] = exp;
-            per_receiver[ri].polys.extend(polys);
-            for c in contacts {
+        for (ri, res) in results.into_iter().enumerate() {
+            per_receiver[ri].exposure[li] = res.exposure;
+            per_receiver[ri].polys.extend(res.polys);
+            per_receiver[ri]
+                .events
+                .extend(res.events.into_iter().map(|e| (li as u32, e)));
+            for c in res.contacts {
                 if !per_receiver[ri].contacts.contains(&c) {
                     per_receiver[ri].contacts.push(c);
                 }
@@ -244,6 +251,25 @@ pub fn shadow_polygons(
         stats.t_isr += t1.elapsed().as_secs_f64();
     }
     Ok((per_receiver, stats))
+}
+
+/// What one light leaves on one receiver.
+struct OnReceiver {
+    exposure: Exposure,
+    polys: Vec<ShadowPolygon>,
+    contacts: Vec<[DVec2; 2]>,
+    events: Vec<[DVec2; 2]>,
+}
+
+impl OnReceiver {
+    fn hidden() -> Self {
+        OnReceiver {
+            exposure: Exposure::Hidden,
+            polys: Vec::new(),
+            contacts: Vec::new(),
+            events: Vec::new(),
+        }
+    }
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -256,12 +282,13 @@ fn receiver_polygons(
     volumes: &[Vec<ShadowVolumes>],
     hits: &[u32],
     eps: f64,
-) -> (Exposure, Vec<ShadowPolygon>, Vec<[DVec2; 2]>) {
+) -> OnReceiver {
     let Some(clipped_light) = light_in_front(kind, r, eps) else {
-        return (Exposure::Hidden, Vec::new(), Vec::new());
+        return OnReceiver::hidden();
     };
     let mut out = Vec::new();
     let mut contacts = Vec::new();
+    let mut events = Vec::new();
     let touch = 1e3 * eps;
     if let LightKind::Area { plane, .. } = kind {
         // Points of the receiver behind the light's plane get nothing from it.
@@ -274,7 +301,7 @@ fn receiver_polygons(
             eps,
         ) {
             if (signed_area_2d(&poly) - r.area).abs() <= 1e-12 * r.area {
-                return (Exposure::Hidden, Vec::new(), Vec::new());
+                return OnReceiver::hidden();
             }
             out.push(ShadowPolygon {
                 light: li,
@@ -315,6 +342,11 @@ fn receiver_polygons(
         for sv in svs {
             for p in &sv.penumbra {
                 if let Some(poly) = clip_to_volume(r, p, eps) {
+                    if let (LightKind::Area { verts, plane, .. }, false) = (kind, sv.hard) {
+                        let lv = clipped_light.as_deref().unwrap_or(verts);
+                        let occ = &scene.occluders[oi as usize];
+                        critical_segments(lv, plane, occ, &scene.faces, r, &poly, eps, &mut events);
+                    }
                     // Point/sun: the one volume is umbra and penumbra at once.
                     out.push(ShadowPolygon {
                         light: li,
@@ -338,5 +370,10 @@ fn receiver_polygons(
             }
         }
     }
-    (Exposure::Regions, out, contacts)
+    OnReceiver {
+        exposure: Exposure::Regions,
+        polys: out,
+        contacts,
+        events,
+    }
 }

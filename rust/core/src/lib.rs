@@ -10,6 +10,7 @@ pub mod direct;
 pub mod edges;
 pub mod elements;
 pub mod error;
+pub mod events;
 pub mod geom;
 pub mod indirect;
 pub mod mesh;

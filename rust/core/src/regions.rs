@@ -149,6 +149,14 @@ pub fn build_regions(
             }
         }
     }
+    let n_polys = sh.polys.len() as u32;
+    for (k, (_, [a, b])) in sh.events.iter().enumerate() {
+        segs.push(Segment {
+            a: *a,
+            b: *b,
+            tag: n_polys + k as u32,
+        });
+    }
     let t_idd = t0.elapsed().as_secs_f64();
     let t1 = std::time::Instant::now();
     let extent = r
@@ -182,6 +190,13 @@ pub fn build_regions(
             }
         }
     }
+    let light_of = |t: u32| {
+        if t < n_polys {
+            sh.polys[t as usize].light
+        } else {
+            sh.events[(t - n_polys) as usize].0
+        }
+    };
     let mut parent: Vec<u32> = (0..arr.faces.len() as u32).collect();
     let mut kept = Vec::new();
     let mut n_disc = 0u64;
@@ -194,7 +209,7 @@ pub fn build_regions(
         let redundant = a != u32::MAX
             && b != u32::MAX
             && e.tags.iter().all(|&t| {
-                let l = sh.polys[t as usize].light as usize;
+                let l = light_of(t) as usize;
                 faces[a as usize].relations[l] == Relation::Umbra
                     && faces[b as usize].relations[l] == Relation::Umbra
             });

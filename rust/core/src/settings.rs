@@ -50,7 +50,7 @@ impl Settings {
         let penumbra_element_size = positive(
             "penumbra_element_size",
             s.penumbra_element_size,
-            (element_size / 5.0).min(element_size),
+            (element_size / 2.0).min(element_size),
         )?;
         let patch_size = positive("patch_size", s.patch_size, element_size * 2.0)?;
         // Only values the user gave: a derived default follows from one of these.
