@@ -1,0 +1,242 @@
+"""Blender → scene arrays for ``penumbra._core``: the selected meshes evaluated with their
+modifiers, in world space, and the lights in scene-JSON form. Only numpy and
+``foreach_get`` touch mesh data; nothing here changes the Blender scene.
+"""
+
+import math
+
+import numpy as np
+
+from .props import QUALITY_FRACTIONS
+
+try:
+    from .cycles_lights import lights_to_scene
+except ImportError:  # FALLBACK until cycles_lights.py lands (branch `cycles`)
+    lights_to_scene = None
+
+try:
+    from .materials import polygon_colors
+except ImportError:  # FALLBACK until materials.py lands (branch `cycles`)
+    polygon_colors = None
+
+# Object types that evaluate to a mesh.
+MESH_TYPES = {"MESH", "CURVE", "SURFACE", "FONT", "META"}
+
+
+class ExportError(Exception):
+    """Bad input found before the bake: the message names the object and the field."""
+
+
+class Export:
+    """What a bake needs: the scene for the core and the source objects, in mesh order."""
+
+    def __init__(self, scene, sources, lights):
+        self.scene = scene
+        self.sources = sources
+        self.lights = lights
+
+
+def export_scene(context, settings, objects=None):
+    """Builds the scene dict from the selection of ``context`` (or from ``objects``).
+
+    Lights are the selected lights, or every visible light when none is selected.
+    Raises ``ExportError`` on bad input.
+    """
+    if objects is None:
+        objects = list(context.selected_objects)
+    sources = [o for o in objects if o.type in MESH_TYPES]
+    if not sources:
+        raise ExportError("Nothing selected: select the meshes to bake")
+    lights = [o for o in objects if o.type == "LIGHT"]
+    if not lights:
+        lights = [
+            o
+            for o in context.view_layer.objects
+            if o.type == "LIGHT" and o.visible_get() and not o.hide_render
+        ]
+    depsgraph = context.evaluated_depsgraph_get()
+
+    meshes = [_mesh(o, depsgraph) for o in sources]
+    light_dicts = []
+    for o in lights:
+        light_dicts.extend(_light(o, depsgraph))
+    emissive = any(np.any(np.asarray(m["emission"]) > 0.0) for m in meshes)
+    if not light_dicts and not emissive:
+        raise ExportError("No lights: add a light or select one (or give a material emission)")
+
+    scene = {"meshes": meshes, "lights": light_dicts, "settings": _settings(settings, meshes, light_dicts)}
+    return Export(scene, sources, lights)
+
+
+def _mesh(obj, depsgraph):
+    obj_eval = obj.evaluated_get(depsgraph)
+    mesh = obj_eval.to_mesh()
+    try:
+        n_vert = len(mesh.vertices)
+        co = np.empty(n_vert * 3, dtype=np.float32)
+        mesh.vertices.foreach_get("co", co)
+        local = co.reshape(-1, 3).astype(np.float64)
+        m = np.array(obj_eval.matrix_world, dtype=np.float64)
+        positions = local @ m[:3, :3].T + m[:3, 3]
+        bad = ~np.isfinite(positions).all(axis=1)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise ExportError(
+                'Object "%s": vertex positions: vertex %d is %s (not a finite number)'
+                % (obj.name, i, tuple(float(x) for x in local[i]))
+            )
+
+        n_poly = len(mesh.polygons)
+        starts = np.empty(n_poly, dtype=np.int64)
+        counts = np.empty(n_poly, dtype=np.int64)
+        mesh.polygons.foreach_get("loop_start", starts)
+        mesh.polygons.foreach_get("loop_total", counts)
+        loop_vert = np.empty(len(mesh.loops), dtype=np.int64)
+        mesh.loops.foreach_get("vertex_index", loop_vert)
+        polygon_vertices = loop_vert[_loop_order(starts, counts, np.linalg.det(m[:3, :3]) < 0.0)]
+
+        if polygon_colors is not None:
+            albedo, emission = polygon_colors(obj_eval, mesh)
+        else:
+            albedo, emission = _fallback_polygon_colors(obj_eval, mesh)
+        return {
+            "name": obj.name,
+            "positions": positions,
+            "polygon_vertices": polygon_vertices,
+            "polygon_counts": counts,
+            "albedo": np.asarray(albedo, dtype=np.float64).reshape(-1, 3),
+            "emission": np.asarray(emission, dtype=np.float64).reshape(-1, 3),
+        }
+    finally:
+        obj_eval.to_mesh_clear()
+
+
+def _loop_order(starts, counts, mirrored):
+    """Loop indices polygon after polygon. A mirroring transform turns counter-clockwise
+    into clockwise, so then each polygon's loops are reversed to keep its front."""
+    total = int(counts.sum())
+    offsets = np.concatenate(([0], np.cumsum(counts)[:-1])) if len(counts) else counts
+    within = np.arange(total) - np.repeat(offsets, counts)
+    if mirrored:
+        within = np.repeat(counts, counts) - 1 - within
+    return np.repeat(starts, counts) + within
+
+
+def _light(obj, depsgraph):
+    light = obj.data
+    if light.type == "AREA":
+        sizes = [("size", light.size)]
+        if light.shape in {"RECTANGLE", "ELLIPSE"}:
+            sizes.append(("size_y", light.size_y))
+        for field, value in sizes:
+            if not value > 0.0:
+                raise ExportError('Light "%s": %s is %g: an area light needs a size above 0' % (obj.name, field, value))
+        scale = obj.matrix_world.to_scale()
+        if abs(scale.x * scale.y) <= 0.0:
+            raise ExportError('Light "%s": scale: the area light is scaled to zero size' % obj.name)
+    if lights_to_scene is not None:
+        dicts = lights_to_scene(obj, depsgraph)
+    else:
+        dicts = _fallback_lights_to_scene(obj)
+    for d in dicts:
+        polygon = d.get("polygon")
+        if polygon is not None and _polygon_area(np.asarray(polygon, dtype=np.float64)) <= 0.0:
+            raise ExportError('Light "%s": size: the light polygon has no area' % obj.name)
+    return dicts
+
+
+def _polygon_area(p):
+    if len(p) < 3 or not np.isfinite(p).all():
+        return 0.0
+    return 0.5 * float(np.linalg.norm(np.cross(p - p[0], np.roll(p, -1, axis=0) - p[0]).sum(axis=0)))
+
+
+def _settings(settings, meshes, lights):
+    pts = [m["positions"] for m in meshes if len(m["positions"])]
+    for d in lights:
+        for key in ("polygon", "point"):
+            if d.get(key) is not None:
+                pts.append(np.asarray(d[key], dtype=np.float64).reshape(-1, 3))
+    allp = np.concatenate(pts) if pts else np.zeros((1, 3))
+    diag = float(np.linalg.norm(allp.max(axis=0) - allp.min(axis=0))) or 1.0
+    if settings.use_custom_size:
+        element, penumbra = settings.element_size, settings.penumbra_element_size
+    else:
+        coarse, fine = QUALITY_FRACTIONS[settings.quality]
+        element, penumbra = coarse * diag, fine * diag
+    return {
+        "element_size": float(element),
+        "penumbra_element_size": float(min(penumbra, element)),
+        "indirect": bool(settings.use_indirect),
+        "convergence": float(settings.convergence),
+        "lighting_only": bool(settings.lighting_only),
+    }
+
+
+# --- FALLBACK until branch `cycles` lands cycles_lights.py and materials.py --------------
+# Minimal stand-ins so that export works and can be tested before then; the real modules
+# match Cycles' units and shaders, these only cover the plain cases.
+
+
+def _fallback_lights_to_scene(obj):
+    light = obj.data
+    m = obj.matrix_world
+    color = [float(c) for c in light.color]
+    power = float(light.energy)
+    if light.type == "AREA":
+        sx = light.size
+        sy = light.size_y if light.shape in {"RECTANGLE", "ELLIPSE"} else light.size
+        if light.shape in {"DISK", "ELLIPSE"}:
+            n = 16
+            local = [(0.5 * sx * math.cos(2 * math.pi * k / n), 0.5 * sy * math.sin(2 * math.pi * k / n)) for k in range(n)]
+        else:
+            local = [(-0.5 * sx, -0.5 * sy), (0.5 * sx, -0.5 * sy), (0.5 * sx, 0.5 * sy), (-0.5 * sx, 0.5 * sy)]
+        # Blender's area light shines along its local -Z: counter-clockwise seen from -Z.
+        world = [m @ _vec(x, y, 0.0) for (x, y) in reversed(local)]
+        area = _polygon_area(np.array([list(v) for v in world]))
+        radiance = power / (math.pi * area) if area > 0 else 0.0
+        return [{"name": obj.name, "polygon": [list(v) for v in world], "radiance": [radiance * c for c in color]}]
+    if light.type in {"POINT", "SPOT"}:
+        d = {"name": obj.name, "point": list(m.translation), "intensity": [power / (4 * math.pi) * c for c in color]}
+        if light.type == "SPOT":
+            axis = (m.to_3x3() @ _vec(0.0, 0.0, -1.0)).normalized()
+            d["spot"] = {"direction": list(axis), "angle": float(light.spot_size), "blend": float(light.spot_blend)}
+        return [d]
+    if light.type == "SUN":
+        axis = (m.to_3x3() @ _vec(0.0, 0.0, -1.0)).normalized()
+        return [{"name": obj.name, "direction": list(axis), "irradiance": [power * c for c in color]}]
+    return []
+
+
+def _vec(x, y, z):
+    from mathutils import Vector
+
+    return Vector((x, y, z))
+
+
+def _fallback_polygon_colors(obj_eval, mesh):
+    n = len(mesh.polygons)
+    slots = []
+    for slot in obj_eval.material_slots:
+        albedo, emission = (0.8, 0.8, 0.8), (0.0, 0.0, 0.0)
+        mat = slot.material
+        if mat is not None:
+            albedo = tuple(mat.diffuse_color[:3])
+            tree = mat.node_tree if getattr(mat, "use_nodes", True) else None
+            bsdf = tree and next((nd for nd in tree.nodes if nd.type == "BSDF_PRINCIPLED"), None)
+            if bsdf:
+                albedo = tuple(bsdf.inputs["Base Color"].default_value[:3])
+                ec = bsdf.inputs.get("Emission Color") or bsdf.inputs.get("Emission")
+                es = bsdf.inputs.get("Emission Strength")
+                if ec is not None:
+                    s = es.default_value if es is not None else 1.0
+                    emission = tuple(s * c for c in ec.default_value[:3])
+        slots.append((albedo, emission))
+    if not slots:
+        return np.full((n, 3), 0.8), np.zeros((n, 3))
+    index = np.empty(n, dtype=np.int64)
+    mesh.polygons.foreach_get("material_index", index)
+    index = np.clip(index, 0, len(slots) - 1)
+    table_a = np.array([s[0] for s in slots], dtype=np.float64)
+    table_e = np.array([s[1] for s in slots], dtype=np.float64)
+    return table_a[index], table_e[index]
