@@ -32,8 +32,10 @@ def import_bake(context, result, sources, hide_originals=False):
     if hide_originals:
         for source in sources:
             source.hide_render = True
-            if source.name in context.view_layer.objects:
+            try:
                 source.hide_set(True)
+            except RuntimeError:  # not in the current view layer: render hiding is enough
+                pass
     return created
 
 
