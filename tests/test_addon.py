@@ -284,8 +284,15 @@ def test_hide_originals_and_rebake(room_scene, empty):
     empty.scene.penumbra.hide_originals = True
     assert bpy.ops.penumbra.bake() == {"FINISHED"}
     assert bpy.data.objects["Floor"].hide_render and bpy.data.objects["Floor"].hide_get()
+    # The originals are hidden now: selecting the baked objects stands for them.
+    baked = list(bpy.data.collections[COLLECTION].objects)
+    room.select_only(empty.view_layer, baked)
+    ex = export_scene(empty, empty.scene.penumbra)
+    assert sorted(m["name"] for m in ex.scene["meshes"]) == sorted(ROOM_MESHES)
     assert bpy.ops.penumbra.bake() == {"FINISHED"}
     assert len([o for o in bpy.data.objects if o.name.startswith("Floor_baked")]) == 1
+    assert len(bpy.data.collections[COLLECTION].objects) == len(ROOM_MESHES)
+    assert len(bpy.data.objects["Floor_baked"].data.polygons) > 0
 
 
 def test_lighting_only_is_brighter_than_albedo_times_light(room_scene, empty):

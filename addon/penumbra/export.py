@@ -5,6 +5,7 @@ modifiers, in world space, and the lights in scene-JSON form. Only numpy and
 
 import math
 
+import bpy
 import numpy as np
 
 from .props import QUALITY_FRACTIONS
@@ -18,6 +19,9 @@ try:
     from .materials import polygon_colors
 except ImportError:  # FALLBACK until materials.py lands (branch `cycles`)
     polygon_colors = None
+
+# Custom property of a baked object: the name of the object it was baked from.
+SOURCE_KEY = "penumbra_source"
 
 # Object types that evaluate to a mesh.
 MESH_TYPES = {"MESH", "CURVE", "SURFACE", "FONT", "META"}
@@ -44,7 +48,7 @@ def export_scene(context, settings, objects=None):
     """
     if objects is None:
         objects = list(context.selected_objects)
-    sources = [o for o in objects if o.type in MESH_TYPES]
+    sources = _sources(objects)
     if not sources:
         raise ExportError("Nothing selected: select the meshes to bake")
     lights = [o for o in objects if o.type == "LIGHT"]
@@ -66,6 +70,23 @@ def export_scene(context, settings, objects=None):
 
     scene = {"meshes": meshes, "lights": light_dicts, "settings": _settings(settings, meshes, light_dicts)}
     return Export(scene, sources, lights)
+
+
+def _sources(objects):
+    """The meshes to bake. A baked object stands for its source, so that selecting a bake
+    and baking again re-bakes the (possibly hidden) original; baked objects themselves are
+    never baked, they would lie on top of their sources."""
+    out = []
+    for o in objects:
+        if o.type not in MESH_TYPES:
+            continue
+        if SOURCE_KEY in o.keys():
+            o = bpy.data.objects.get(o[SOURCE_KEY])
+            if o is None or o.type not in MESH_TYPES:
+                continue
+        if o not in out:
+            out.append(o)
+    return out
 
 
 def _mesh(obj, depsgraph):

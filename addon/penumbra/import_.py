@@ -6,6 +6,8 @@ shows it as emission, so that any engine displays the bake as it is.
 import bpy
 import numpy as np
 
+from .export import SOURCE_KEY
+
 COLLECTION = "Penumbra Bake"
 ATTRIBUTE = "Radiosity"
 SOURCE_ATTRIBUTE = "penumbra_source_polygon"
@@ -27,6 +29,7 @@ def import_bake(context, result, sources, hide_originals=False):
         mesh = _mesh(name, baked)
         mesh.materials.append(material)
         obj = bpy.data.objects.new(name, mesh)
+        obj[SOURCE_KEY] = source.name
         collection.objects.link(obj)
         created.append(obj)
     if hide_originals:
