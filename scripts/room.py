@@ -11,7 +11,7 @@ ROOM = (4.0, 4.0, 2.5)  # x, y extent (centred on the origin) and height
 def _material(name, color):
     mat = bpy.data.materials.get(name) or bpy.data.materials.new(name)
     mat.diffuse_color = (color[0], color[1], color[2], 1.0)
-    if hasattr(mat, "use_nodes"):
+    if bpy.app.version < (5, 0, 0):  # node trees are always on from Blender 5
         mat.use_nodes = True
     bsdf = next((n for n in mat.node_tree.nodes if n.type == "BSDF_PRINCIPLED"), None)
     if bsdf is not None:

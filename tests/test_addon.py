@@ -1,6 +1,7 @@
 """The add-on inside Blender (bpy module): export, import, the operator, bad input."""
 
 import math
+import time
 
 import bpy
 import numpy as np
@@ -54,6 +55,8 @@ def _normals(m):
 
 def test_operator_and_panel_are_registered():
     assert bpy.ops.penumbra.bake.get_rna_type().name == "Bake Radiosity"
+    # One undo step takes a bake back (Blender pushes it when the operator finishes).
+    assert {"REGISTER", "UNDO"} <= set(bpy.types.PENUMBRA_OT_bake.bl_options)
     panel = bpy.types.PENUMBRA_PT_radiosity
     assert panel.bl_label == "Radiosity" and panel.bl_context == "render"
     assert bpy.context.scene.penumbra.quality == "MEDIUM"
@@ -304,3 +307,110 @@ def test_lighting_only_is_brighter_than_albedo_times_light(room_scene, empty):
     assert bpy.ops.penumbra.bake() == {"FINISHED"}
     _, light_only = _colors(bpy.data.objects["Floor_baked"])
     assert light_only.sum() > with_albedo.sum() > 0
+
+
+# --- the modal path, driven by hand (there is no window in the bpy module) -------------------
+
+
+class _WindowManager:
+    def __init__(self):
+        self.calls = []
+
+    def event_timer_add(self, step, window=None):
+        self.calls.append("timer_add")
+        return "timer"
+
+    def event_timer_remove(self, timer):
+        self.calls.append("timer_remove")
+
+    def progress_begin(self, lo, hi):
+        self.calls.append("progress_begin")
+
+    def progress_update(self, value):
+        self.calls.append(("progress", value))
+
+    def progress_end(self):
+        self.calls.append("progress_end")
+
+    def modal_handler_add(self, op):
+        self.calls.append("modal")
+
+
+class _Workspace:
+    def __init__(self):
+        self.status = []
+
+    def status_text_set(self, text):
+        self.status.append(text)
+
+
+class _Context:
+    """bpy.context with a window: the operator's modal path runs as under the UI."""
+
+    def __init__(self):
+        self.window_manager = _WindowManager()
+        self.workspace = _Workspace()
+        self.window = object()
+
+    def __getattr__(self, name):
+        return getattr(bpy.context, name)
+
+
+class _Event:
+    def __init__(self, type, value="NOTHING"):
+        self.type, self.value = type, value
+
+
+class _Operator:
+    """Stands in for the operator instance: its methods are plain functions on the class."""
+
+    def __init__(self):
+        self.reports = Reports()
+
+    def report(self, level, message):
+        self.reports(level, message)
+
+
+def _modal_op():
+    op = _Operator()
+    cls = bpy.types.PENUMBRA_OT_bake
+    op.modal = lambda ctx, ev: cls.modal(op, ctx, ev)
+    op._end = lambda ctx: cls._end(op, ctx)
+    op.invoke = lambda ctx, ev: cls.invoke(op, ctx, ev)
+    op.execute = lambda ctx: cls.execute(op, ctx)
+    return op
+
+
+def test_modal_escape_cancels_and_changes_nothing(room_scene, empty, monkeypatch):
+    empty.scene.penumbra.quality = "HIGH"
+    before = snapshot()
+    op, ctx = _modal_op(), _Context()
+    import penumbra.operators as ops
+
+    monkeypatch.setattr(ops, "has_ui", lambda context: True)
+    assert op.invoke(ctx, _Event("NONE")) == {"RUNNING_MODAL"}
+    assert op.modal(ctx, _Event("MOUSEMOVE")) == {"PASS_THROUGH"}  # the UI stays usable
+    assert op.modal(ctx, _Event("ESC", "PRESS")) == {"CANCELLED"}
+    assert op._job.cancelled()
+    assert ctx.window_manager.calls[-2:] == ["timer_remove", "progress_end"]
+    assert ctx.workspace.status[-1] is None
+    assert snapshot() == before
+
+
+def test_modal_timer_polls_until_the_bake_is_imported(room_scene, empty, monkeypatch):
+    import penumbra.operators as ops
+
+    monkeypatch.setattr(ops, "has_ui", lambda context: True)
+    op, ctx = _modal_op(), _Context()
+    assert op.invoke(ctx, _Event("NONE")) == {"RUNNING_MODAL"}
+    outcome = {"RUNNING_MODAL"}
+    for _ in range(6000):
+        outcome = op.modal(ctx, _Event("TIMER"))
+        if outcome != {"RUNNING_MODAL"}:
+            break
+        time.sleep(0.01)
+    assert outcome == {"FINISHED"}, op.reports.items
+    assert any(isinstance(c, tuple) and c[0] == "progress" for c in ctx.window_manager.calls)
+    assert any(s and s.startswith("Penumbra: ") for s in ctx.workspace.status)
+    assert len(bpy.data.collections[COLLECTION].objects) == len(ROOM_MESHES)
+    assert "elements" in op.reports.items[-1][1]

@@ -243,7 +243,7 @@ def _fallback_polygon_colors(obj_eval, mesh):
         mat = slot.material
         if mat is not None:
             albedo = tuple(mat.diffuse_color[:3])
-            tree = mat.node_tree if getattr(mat, "use_nodes", True) else None
+            tree = mat.node_tree
             bsdf = tree and next((nd for nd in tree.nodes if nd.type == "BSDF_PRINCIPLED"), None)
             if bsdf:
                 albedo = tuple(bsdf.inputs["Base Color"].default_value[:3])

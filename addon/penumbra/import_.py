@@ -103,7 +103,7 @@ def _material():
     if mat is not None:
         return mat
     mat = bpy.data.materials.new(MATERIAL)
-    if hasattr(mat, "use_nodes"):
+    if bpy.app.version < (5, 0, 0):  # node trees are always on from Blender 5
         mat.use_nodes = True
     tree = mat.node_tree
     tree.nodes.clear()

@@ -72,6 +72,11 @@ def bake_blocking(context, report):
     return finish(context, export, result, time.perf_counter() - t0, report)
 
 
+def has_ui(context):
+    """False in ``blender -b`` and in the bpy module: there the bake runs synchronously."""
+    return not bpy.app.background and context.window is not None
+
+
 def overall_fraction(stage, fraction):
     if stage not in STAGES:
         return 0.0
@@ -93,7 +98,7 @@ class PENUMBRA_OT_bake(bpy.types.Operator):
         return bake_blocking(context, self.report)
 
     def invoke(self, context, event):
-        if bpy.app.background or context.window is None:
+        if not has_ui(context):
             return self.execute(context)
         self._export = prepare(context, self.report)
         if self._export is None:
