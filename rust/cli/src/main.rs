@@ -1,1 +1,200 @@
-fn main(){}
+//! `penumbra`: bake a scene JSON file into a bake JSON file.
+//!
+//! Exit codes: 0 success, 2 invalid input (one line on stderr naming the object and field),
+//! 1 I/O failure writing the output, 3 internal error (a bug: reported in one line, no trace).
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::time::Duration;
+
+use clap::{Parser, Subcommand};
+use penumbra::{BakeError, Progress};
+
+#[derive(Parser)]
+#[command(
+    name = "penumbra",
+    version,
+    about = "Discontinuity-meshing radiosity baker"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Bake SCENE (scene JSON, `-` for stdin) and write the bake JSON.
+    Bake {
+        scene: PathBuf,
+        /// Output file (bake JSON); `-` for stdout.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Print the stats table (paper's names) to stderr when done.
+        #[arg(long)]
+        stats: bool,
+        /// Worker threads (default: all cores).
+        #[arg(long)]
+        threads: Option<u32>,
+    },
+    /// Check SCENE and report problems without baking.
+    Validate { scene: PathBuf },
+    /// Write a built-in scene (data1, data2, chair, cornell, room) as scene JSON.
+    Scene {
+        name: String,
+        #[arg(short, long)]
+        output: PathBuf,
+    },
+}
+
+fn read(path: &PathBuf) -> Result<String, String> {
+    if path.as_os_str() == "-" {
+        let mut s = String::new();
+        std::io::Read::read_to_string(&mut std::io::stdin(), &mut s)
+            .map_err(|e| format!("stdin: {e}"))?;
+        Ok(s)
+    } else {
+        std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))
+    }
+}
+
+fn fail(code: u8, msg: impl std::fmt::Display) -> ExitCode {
+    eprintln!("penumbra: {msg}");
+    ExitCode::from(code)
+}
+
+fn main() -> ExitCode {
+    // A bug must still end in one line, not a backtrace.
+    std::panic::set_hook(Box::new(|info| {
+        let msg = info
+            .payload()
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| info.payload().downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "unknown panic".into());
+        let at = info
+            .location()
+            .map(|l| format!(" at {}:{}", l.file(), l.line()))
+            .unwrap_or_default();
+        eprintln!("penumbra: internal error: {msg}{at}");
+    }));
+    let cli = Cli::parse();
+    match std::panic::catch_unwind(|| run(cli)) {
+        Ok(code) => code,
+        Err(_) => ExitCode::from(3),
+    }
+}
+
+fn run(cli: Cli) -> ExitCode {
+    match cli.command {
+        Command::Scene { name, output } => {
+            let Some(s) = penumbra_cli::scenes::by_name(&name) else {
+                return fail(
+                    2,
+                    format!(
+                        "unknown scene {name:?} (one of {})",
+                        penumbra_cli::scenes::NAMES.join(", ")
+                    ),
+                );
+            };
+            let json = serde_json::to_string_pretty(&s).expect("scene serialises");
+            match std::fs::write(&output, json) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => fail(1, format!("{}: {e}", output.display())),
+            }
+        }
+        Command::Validate { scene } => {
+            let text = match read(&scene) {
+                Ok(t) => t,
+                Err(e) => return fail(2, e),
+            };
+            match penumbra::SceneJson::from_str(&text).and_then(|j| penumbra::scene::validate(&j)) {
+                Ok(s) => {
+                    for w in &s.warnings {
+                        eprintln!("penumbra: warning: {w}");
+                    }
+                    println!(
+                        "ok: {} meshes, {} convex faces, {} lights",
+                        s.meshes.len(),
+                        s.faces.len(),
+                        s.lights.len()
+                    );
+                    ExitCode::SUCCESS
+                }
+                Err(e) => fail(2, e),
+            }
+        }
+        Command::Bake {
+            scene,
+            output,
+            stats,
+            threads,
+        } => {
+            let text = match read(&scene) {
+                Ok(t) => t,
+                Err(e) => return fail(2, e),
+            };
+            let mut sc = match penumbra::SceneJson::from_str(&text)
+                .and_then(|j| penumbra::scene::validate(&j))
+            {
+                Ok(s) => s,
+                Err(e) => return fail(2, e),
+            };
+            if let Some(t) = threads {
+                if t == 0 {
+                    return fail(2, "--threads: must be at least 1");
+                }
+                sc.settings.threads = Some(t);
+            }
+            for w in &sc.warnings {
+                eprintln!("penumbra: warning: {w}");
+            }
+            let progress = Arc::new(Progress::new());
+            let bar = std::io::stderr()
+                .is_terminal()
+                .then(|| spawn_bar(progress.clone()));
+            let result = penumbra::bake(&sc, &progress);
+            progress.cancel(); // stops the bar thread
+            if let Some(h) = bar {
+                let _ = h.join();
+            }
+            let bake = match result {
+                Ok(b) => b,
+                Err(e @ BakeError::Cancelled) => return fail(1, e),
+                Err(e) => return fail(2, e),
+            };
+            let json = bake.to_json();
+            let written = if output.as_os_str() == "-" {
+                println!("{json}");
+                Ok(())
+            } else {
+                std::fs::write(&output, json)
+            };
+            if let Err(e) = written {
+                return fail(1, format!("{}: {e}", output.display()));
+            }
+            if stats {
+                eprint!("{}", penumbra::bake::stats_table(&bake.stats));
+            }
+            ExitCode::SUCCESS
+        }
+    }
+}
+
+fn spawn_bar(p: Arc<Progress>) -> std::thread::JoinHandle<()> {
+    std::thread::spawn(move || {
+        let bar = indicatif::ProgressBar::new(1000);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{spinner} {msg:24} [{bar:40}] {percent:>3}%")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        while !p.is_cancelled() {
+            let (stage, f) = p.get();
+            bar.set_message(stage);
+            bar.set_position((f * 1000.0) as u64);
+            std::thread::sleep(Duration::from_millis(100));
+        }
+        bar.finish_and_clear();
+    })
+}

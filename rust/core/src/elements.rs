@@ -9,6 +9,9 @@ use crate::relation::Relation;
 #[derive(Debug, Clone, Default)]
 pub struct Elements {
     pub positions: Vec<DVec3>,
+    /// Where lighting is evaluated for each vertex: its position, except for vertices on a
+    /// D0 row, which sit a hair inside their own side so they take that side's limit.
+    pub eval: Vec<DVec3>,
     /// Unit normal of the vertex's receiver face (its front).
     pub normals: Vec<DVec3>,
     /// Receiver face (index into `Scene::faces`) of each vertex.

@@ -4,14 +4,19 @@
 //! The pipeline runs one direction: `scene` → `shadow` → `edges` → `arrangement`/`relation`
 //! → `mesh` → `direct` → `indirect` → `bake` (output).
 
+pub mod arrangement;
 pub mod bake;
+pub mod edges;
 pub mod elements;
 pub mod error;
 pub mod geom;
+pub mod mesh;
 pub mod progress;
+pub mod regions;
 pub mod relation;
 pub mod scene;
 pub mod settings;
+pub mod shadow;
 
 pub use bake::{bake, bake_scene_json, Bake, BakedMesh, Stats};
 pub use error::BakeError;

@@ -25,7 +25,8 @@ impl Progress {
     }
 
     pub fn set_fraction(&self, f: f64) {
-        self.fraction.store(f.clamp(0.0, 1.0).to_bits(), Ordering::Relaxed);
+        self.fraction
+            .store(f.clamp(0.0, 1.0).to_bits(), Ordering::Relaxed);
     }
 
     /// (stage name, fraction of that stage done in [0, 1]).

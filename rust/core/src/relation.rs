@@ -39,7 +39,10 @@ pub struct RelationSet {
 
 impl RelationSet {
     pub fn new(n_lights: usize) -> Self {
-        RelationSet { bits: vec![0; n_lights.div_ceil(32)], n: n_lights }
+        RelationSet {
+            bits: vec![0; n_lights.div_ceil(32)],
+            n: n_lights,
+        }
     }
     pub fn len(&self) -> usize {
         self.n
@@ -73,7 +76,11 @@ mod test {
         }
         s.set(33, Relation::Umbra);
         for i in 0..70 {
-            let want = if i == 33 { Relation::Umbra } else { Relation::from_code((i % 3 + 1) as u8) };
+            let want = if i == 33 {
+                Relation::Umbra
+            } else {
+                Relation::from_code((i % 3 + 1) as u8)
+            };
             assert_eq!(s.get(i), want);
         }
         assert_eq!(RelationSet::new(16).packed_bytes(), 4);

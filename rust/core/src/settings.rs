@@ -39,19 +39,36 @@ pub const DEFAULT_MAX_ELEMENTS: u64 = 4_000_000;
 impl Settings {
     /// Defaults for a scene whose bounding box has diagonal `diag`.
     pub fn from_json(s: &SettingsJson, diag: f64) -> Result<Self, BakeError> {
-        let diag = if diag > 0.0 && diag.is_finite() { diag } else { 1.0 };
+        let diag = if diag > 0.0 && diag.is_finite() {
+            diag
+        } else {
+            1.0
+        };
         let element_size = positive("element_size", s.element_size, diag / 25.0)?;
-        let penumbra_element_size =
-            positive("penumbra_element_size", s.penumbra_element_size, (element_size / 5.0).min(element_size))?;
+        let penumbra_element_size = positive(
+            "penumbra_element_size",
+            s.penumbra_element_size,
+            (element_size / 5.0).min(element_size),
+        )?;
         let patch_size = positive("patch_size", s.patch_size, element_size * 2.0)?;
-        for (name, v) in [("element_size", element_size), ("penumbra_element_size", penumbra_element_size), ("patch_size", patch_size)] {
+        for (name, v) in [
+            ("element_size", element_size),
+            ("penumbra_element_size", penumbra_element_size),
+            ("patch_size", patch_size),
+        ] {
             if v < diag * 1e-7 {
-                return Err(BakeError::setting(name, format!("{v} is below 1e-7 of the scene size {diag}")));
+                return Err(BakeError::setting(
+                    name,
+                    format!("{v} is below 1e-7 of the scene size {diag}"),
+                ));
             }
         }
         let min_angle = s.min_angle.unwrap_or(25.0);
         if !(min_angle.is_finite() && (0.0..=33.0).contains(&min_angle)) {
-            return Err(BakeError::setting("min_angle", format!("{min_angle} must be in [0, 33] degrees")));
+            return Err(BakeError::setting(
+                "min_angle",
+                format!("{min_angle} must be in [0, 33] degrees"),
+            ));
         }
         let max_elements = s.max_elements.unwrap_or(DEFAULT_MAX_ELEMENTS);
         if max_elements == 0 {
@@ -59,25 +76,42 @@ impl Settings {
         }
         let convergence = s.convergence.unwrap_or(1e-3);
         if !(convergence.is_finite() && convergence > 0.0 && convergence < 1.0) {
-            return Err(BakeError::setting("convergence", format!("{convergence} must be in (0, 1)")));
+            return Err(BakeError::setting(
+                "convergence",
+                format!("{convergence} must be in (0, 1)"),
+            ));
         }
         let penumbra_visibility = match s.penumbra_visibility.as_deref() {
             None | Some("exact") => PenumbraVisibility::Exact,
             Some("sampled") => PenumbraVisibility::Sampled,
-            Some(o) => return Err(BakeError::setting("penumbra_visibility", format!("{o:?} is not \"exact\" or \"sampled\""))),
+            Some(o) => {
+                return Err(BakeError::setting(
+                    "penumbra_visibility",
+                    format!("{o:?} is not \"exact\" or \"sampled\""),
+                ))
+            }
         };
         let penumbra_samples = s.penumbra_samples.unwrap_or(64);
         if !(1..=65536).contains(&penumbra_samples) {
-            return Err(BakeError::setting("penumbra_samples", format!("{penumbra_samples} must be in [1, 65536]")));
+            return Err(BakeError::setting(
+                "penumbra_samples",
+                format!("{penumbra_samples} must be in [1, 65536]"),
+            ));
         }
         let visibility_rays = s.visibility_rays.unwrap_or(16);
         if !(1..=4096).contains(&visibility_rays) {
-            return Err(BakeError::setting("visibility_rays", format!("{visibility_rays} must be in [1, 4096]")));
+            return Err(BakeError::setting(
+                "visibility_rays",
+                format!("{visibility_rays} must be in [1, 4096]"),
+            ));
         }
         let max_shots = s.max_shots.unwrap_or(100_000);
         if let Some(t) = s.threads {
             if t == 0 || t > 1024 {
-                return Err(BakeError::setting("threads", format!("{t} must be in [1, 1024]")));
+                return Err(BakeError::setting(
+                    "threads",
+                    format!("{t} must be in [1, 1024]"),
+                ));
             }
         }
         Ok(Settings {
@@ -103,6 +137,9 @@ fn positive(name: &str, v: Option<f64>, default: f64) -> Result<f64, BakeError> 
     match v {
         None => Ok(default),
         Some(x) if x.is_finite() && x > 0.0 => Ok(x),
-        Some(x) => Err(BakeError::setting(name, format!("{x} must be a positive finite length"))),
+        Some(x) => Err(BakeError::setting(
+            name,
+            format!("{x} must be a positive finite length"),
+        )),
     }
 }

@@ -51,7 +51,12 @@ mod test {
 
     #[test]
     fn roundtrip_and_handedness() {
-        for n in [DVec3::Z, -DVec3::Z, DVec3::new(1., 2., 3.), DVec3::new(-1e-9, 1.0, 0.0)] {
+        for n in [
+            DVec3::Z,
+            -DVec3::Z,
+            DVec3::new(1., 2., 3.),
+            DVec3::new(-1e-9, 1.0, 0.0),
+        ] {
             let f = Frame::new(DVec3::new(1., 2., 3.), n);
             assert!((f.u.cross(f.v) - f.n).length() < 1e-12);
             let p = f.to_3d(DVec2::new(0.3, -0.7));

@@ -39,7 +39,10 @@ impl Plane {
     }
 
     pub fn flipped(&self) -> Self {
-        Plane { n: -self.n, d: -self.d }
+        Plane {
+            n: -self.n,
+            d: -self.d,
+        }
     }
 }
 
@@ -62,7 +65,12 @@ mod test {
 
     #[test]
     fn ccw_square_faces_up() {
-        let sq = [DVec3::new(0., 0., 1.), DVec3::new(1., 0., 1.), DVec3::new(1., 1., 1.), DVec3::new(0., 1., 1.)];
+        let sq = [
+            DVec3::new(0., 0., 1.),
+            DVec3::new(1., 0., 1.),
+            DVec3::new(1., 1., 1.),
+            DVec3::new(0., 1., 1.),
+        ];
         let p = Plane::from_polygon(&sq).unwrap();
         assert!((p.n - DVec3::Z).length() < 1e-15);
         assert!((p.d - 1.0).abs() < 1e-15);

@@ -156,19 +156,31 @@ mod test {
     use super::*;
 
     fn square() -> Vec<DVec2> {
-        vec![DVec2::new(0., 0.), DVec2::new(1., 0.), DVec2::new(1., 1.), DVec2::new(0., 1.)]
+        vec![
+            DVec2::new(0., 0.),
+            DVec2::new(1., 0.),
+            DVec2::new(1., 1.),
+            DVec2::new(0., 1.),
+        ]
     }
 
     #[test]
     fn clip_square_in_half() {
-        let h = HalfPlane { n: DVec2::new(1.0, 0.0), c: 0.5 };
+        let h = HalfPlane {
+            n: DVec2::new(1.0, 0.0),
+            c: 0.5,
+        };
         let r = clip_polygon_2d(&square(), &h, 0.0);
         assert!((signed_area_2d(&r) - 0.5).abs() < 1e-15);
     }
 
     #[test]
     fn clip_3d_keeps_positive_side() {
-        let tri = [DVec3::new(0., 0., -1.), DVec3::new(1., 0., 1.), DVec3::new(0., 1., 1.)];
+        let tri = [
+            DVec3::new(0., 0., -1.),
+            DVec3::new(1., 0., 1.),
+            DVec3::new(0., 1., 1.),
+        ];
         let r = clip_polygon_3d(&tri, &Plane::new(DVec3::Z, 0.0), 0.0);
         assert!(r.iter().all(|p| p.z >= -1e-15));
         assert_eq!(r.len(), 4);
@@ -184,7 +196,13 @@ mod test {
 
     #[test]
     fn simplify_drops_collinear() {
-        let p = vec![DVec2::new(0., 0.), DVec2::new(0.5, 0.), DVec2::new(1., 0.), DVec2::new(1., 1.), DVec2::new(1., 1.)];
+        let p = vec![
+            DVec2::new(0., 0.),
+            DVec2::new(0.5, 0.),
+            DVec2::new(1., 0.),
+            DVec2::new(1., 1.),
+            DVec2::new(1., 1.),
+        ];
         assert_eq!(simplify_convex(&p).len(), 3);
     }
 }

@@ -25,9 +25,13 @@ pub fn convex_pieces(pts: &[DVec3]) -> Vec<Vec<DVec3>> {
     if p.len() < 3 {
         return Vec::new();
     }
-    let Some(plane) = Plane::from_polygon(&p) else { return Vec::new() };
+    let Some(plane) = Plane::from_polygon(&p) else {
+        return Vec::new();
+    };
     let extent = p.iter().map(|q| (*q - p[0]).length()).fold(0.0, f64::max);
-    let planar = p.iter().all(|q| plane.dist(*q).abs() <= PLANAR_TOL * extent);
+    let planar = p
+        .iter()
+        .all(|q| plane.dist(*q).abs() <= PLANAR_TOL * extent);
     let frame = Frame::on_plane(&plane, p[0]);
     let p2: Vec<DVec2> = p.iter().map(|q| frame.to_2d(*q)).collect();
 
@@ -88,7 +92,9 @@ fn ear_clip(p: &[DVec2]) -> Vec<[usize; 3]> {
                     return false;
                 }
                 let q = p[j];
-                orient(a, b, q) * sign >= 0.0 && orient(b, c, q) * sign >= 0.0 && orient(c, a, q) * sign >= 0.0
+                orient(a, b, q) * sign >= 0.0
+                    && orient(b, c, q) * sign >= 0.0
+                    && orient(c, a, q) * sign >= 0.0
             });
             if !blocked {
                 out.push([ia, ib, ic]);
@@ -116,7 +122,9 @@ mod test {
     use super::*;
 
     fn area3(ps: &[Vec<DVec3>]) -> f64 {
-        ps.iter().map(|p| crate::geom::plane::newell_normal(p).length() * 0.5).sum()
+        ps.iter()
+            .map(|p| crate::geom::plane::newell_normal(p).length() * 0.5)
+            .sum()
     }
 
     #[test]

@@ -109,7 +109,8 @@ pub struct SettingsJson {
 impl SceneJson {
     /// Parses scene JSON text and checks `format` and `version`.
     pub fn from_str(text: &str) -> Result<Self, crate::BakeError> {
-        let s: SceneJson = serde_json::from_str(text).map_err(|e| crate::BakeError::Format(e.to_string()))?;
+        let s: SceneJson =
+            serde_json::from_str(text).map_err(|e| crate::BakeError::Format(e.to_string()))?;
         if s.format != SCENE_FORMAT {
             return Err(crate::BakeError::Format(format!(
                 "format is {:?}, expected {SCENE_FORMAT:?}",

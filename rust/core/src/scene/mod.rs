@@ -49,9 +49,17 @@ pub struct Spot {
 #[derive(Debug, Clone, PartialEq)]
 pub enum LightKind {
     /// A uniform diffuse convex polygon emitting from its front (counter-clockwise side).
-    Area { verts: Vec<DVec3>, plane: Plane, radiance: DVec3 },
+    Area {
+        verts: Vec<DVec3>,
+        plane: Plane,
+        radiance: DVec3,
+    },
     /// An isotropic point (W/sr), optionally masked by a spot cone.
-    Point { position: DVec3, intensity: DVec3, spot: Option<Spot> },
+    Point {
+        position: DVec3,
+        intensity: DVec3,
+        spot: Option<Spot>,
+    },
     /// A directional light: `direction` is where the light travels (unit), `irradiance` on a
     /// surface facing it (W/m²).
     Sun { direction: DVec3, irradiance: DVec3 },

@@ -27,16 +27,25 @@ pub fn validate(s: &SceneJson) -> Result<Scene, BakeError> {
         return Err(BakeError::Empty("the scene has no meshes".into()));
     }
     if s.lights.is_empty() && !has_emission(s) {
-        return Err(BakeError::Empty("the scene has no lights and no emissive polygons".into()));
+        return Err(BakeError::Empty(
+            "the scene has no lights and no emissive polygons".into(),
+        ));
     }
     for (mi, m) in s.meshes.iter().enumerate() {
         let obj = format!("mesh {:?} (meshes[{mi}])", m.name);
         let start = faces.len();
         validate_mesh(mi, m, &obj, &mut faces, &mut warnings, &mut lo, &mut hi)?;
-        meshes.push(MeshInfo { name: m.name.clone(), n_polygons: m.polygons.len(), face_start: start, face_end: faces.len() });
+        meshes.push(MeshInfo {
+            name: m.name.clone(),
+            n_polygons: m.polygons.len(),
+            face_start: start,
+            face_end: faces.len(),
+        });
     }
     if faces.is_empty() {
-        return Err(BakeError::Empty("every polygon of every mesh is degenerate (no area)".into()));
+        return Err(BakeError::Empty(
+            "every polygon of every mesh is degenerate (no area)".into(),
+        ));
     }
     let mut lights = Vec::with_capacity(s.lights.len());
     for (li, l) in s.lights.iter().enumerate() {
@@ -70,7 +79,15 @@ pub fn validate(s: &SceneJson) -> Result<Scene, BakeError> {
             ),
         ));
     }
-    Ok(Scene { meshes, faces, lights, settings, bounds_min: lo, bounds_max: hi, warnings })
+    Ok(Scene {
+        meshes,
+        faces,
+        lights,
+        settings,
+        bounds_min: lo,
+        bounds_max: hi,
+        warnings,
+    })
 }
 
 fn has_emission(s: &SceneJson) -> bool {
@@ -84,10 +101,18 @@ fn has_emission(s: &SceneJson) -> bool {
 fn check_point(obj: &str, field: &str, p: [f64; 3]) -> Result<DVec3, BakeError> {
     for (k, &x) in p.iter().enumerate() {
         if !x.is_finite() {
-            return Err(BakeError::invalid(obj, field, format!("coordinate {k} is {x}, not a finite number")));
+            return Err(BakeError::invalid(
+                obj,
+                field,
+                format!("coordinate {k} is {x}, not a finite number"),
+            ));
         }
         if x.abs() > MAX_COORD {
-            return Err(BakeError::invalid(obj, field, format!("coordinate {k} = {x} is beyond ±{MAX_COORD:e}")));
+            return Err(BakeError::invalid(
+                obj,
+                field,
+                format!("coordinate {k} = {x} is beyond ±{MAX_COORD:e}"),
+            ));
         }
     }
     Ok(DVec3::from_array(p))
@@ -96,21 +121,39 @@ fn check_point(obj: &str, field: &str, p: [f64; 3]) -> Result<DVec3, BakeError> 
 fn check_color(obj: &str, field: &str, c: [f64; 3], max: f64) -> Result<DVec3, BakeError> {
     for (k, &x) in c.iter().enumerate() {
         if !x.is_finite() || x < 0.0 || x > max {
-            return Err(BakeError::invalid(obj, field, format!("channel {k} is {x}, must be in [0, {max}]")));
+            return Err(BakeError::invalid(
+                obj,
+                field,
+                format!("channel {k} is {x}, must be in [0, {max}]"),
+            ));
         }
     }
     Ok(DVec3::from_array(c))
 }
 
-fn per_polygon(obj: &str, field: &str, v: &Option<PerPolygon>, n: usize, default: [f64; 3], max: f64) -> Result<Vec<DVec3>, BakeError> {
+fn per_polygon(
+    obj: &str,
+    field: &str,
+    v: &Option<PerPolygon>,
+    n: usize,
+    default: [f64; 3],
+    max: f64,
+) -> Result<Vec<DVec3>, BakeError> {
     match v {
         None => Ok(vec![DVec3::from_array(default); n]),
         Some(PerPolygon::Uniform(c)) => Ok(vec![check_color(obj, field, *c, max)?; n]),
         Some(PerPolygon::PerPolygon(cs)) => {
             if cs.len() != n {
-                return Err(BakeError::invalid(obj, field, format!("has {} entries for {n} polygons", cs.len())));
+                return Err(BakeError::invalid(
+                    obj,
+                    field,
+                    format!("has {} entries for {n} polygons", cs.len()),
+                ));
             }
-            cs.iter().enumerate().map(|(i, c)| check_color(obj, &format!("{field}[{i}]"), *c, max)).collect()
+            cs.iter()
+                .enumerate()
+                .map(|(i, c)| check_color(obj, &format!("{field}[{i}]"), *c, max))
+                .collect()
         }
     }
 }
@@ -125,14 +168,36 @@ fn validate_mesh(
     lo: &mut DVec3,
     hi: &mut DVec3,
 ) -> Result<(), BakeError> {
-    let pos: Vec<DVec3> =
-        m.positions.iter().enumerate().map(|(i, p)| check_point(obj, &format!("positions[{i}]"), *p)).collect::<Result<_, _>>()?;
-    let albedo = per_polygon(obj, "albedo", &m.albedo, m.polygons.len(), [0.8, 0.8, 0.8], 1.0)?;
-    let emission = per_polygon(obj, "emission", &m.emission, m.polygons.len(), [0.0; 3], MAX_RADIANCE)?;
+    let pos: Vec<DVec3> = m
+        .positions
+        .iter()
+        .enumerate()
+        .map(|(i, p)| check_point(obj, &format!("positions[{i}]"), *p))
+        .collect::<Result<_, _>>()?;
+    let albedo = per_polygon(
+        obj,
+        "albedo",
+        &m.albedo,
+        m.polygons.len(),
+        [0.8, 0.8, 0.8],
+        1.0,
+    )?;
+    let emission = per_polygon(
+        obj,
+        "emission",
+        &m.emission,
+        m.polygons.len(),
+        [0.0; 3],
+        MAX_RADIANCE,
+    )?;
     let mut dropped = 0usize;
     for (pi, poly) in m.polygons.iter().enumerate() {
         if poly.len() < 3 {
-            return Err(BakeError::invalid(obj, format!("polygons[{pi}]"), format!("has {} vertices, needs at least 3", poly.len())));
+            return Err(BakeError::invalid(
+                obj,
+                format!("polygons[{pi}]"),
+                format!("has {} vertices, needs at least 3", poly.len()),
+            ));
         }
         let mut pts = Vec::with_capacity(poly.len());
         for (k, &ix) in poly.iter().enumerate() {
@@ -140,7 +205,10 @@ fn validate_mesh(
                 return Err(BakeError::invalid(
                     obj,
                     format!("polygons[{pi}][{k}]"),
-                    format!("index {ix} is out of range (the mesh has {} positions)", pos.len()),
+                    format!(
+                        "index {ix} is out of range (the mesh has {} positions)",
+                        pos.len()
+                    ),
                 ));
             }
             pts.push(pos[ix as usize]);
@@ -151,7 +219,9 @@ fn validate_mesh(
             continue;
         }
         for verts in pieces {
-            let Some(plane) = Plane::from_polygon(&verts) else { continue };
+            let Some(plane) = Plane::from_polygon(&verts) else {
+                continue;
+            };
             let frame = Frame::on_plane(&plane, verts[0]);
             let poly2: Vec<_> = verts.iter().map(|v| frame.to_2d(*v)).collect();
             let area = crate::geom::polygon::signed_area_2d(&poly2);
@@ -176,63 +246,140 @@ fn validate_mesh(
         }
     }
     if dropped > 0 {
-        warnings.push(format!("{obj}: dropped {dropped} degenerate polygon(s) with no area"));
+        warnings.push(format!(
+            "{obj}: dropped {dropped} degenerate polygon(s) with no area"
+        ));
     }
     Ok(())
 }
 
 fn validate_light(li: usize, l: &LightJson, obj: &str) -> Result<Light, BakeError> {
-    let kinds = [l.polygon.is_some(), l.point.is_some(), l.direction.is_some() && l.spot.is_none() && l.point.is_none()];
+    let kinds = [
+        l.polygon.is_some(),
+        l.point.is_some(),
+        l.direction.is_some() && l.spot.is_none() && l.point.is_none(),
+    ];
     let n_kinds = kinds.iter().filter(|&&k| k).count();
     if n_kinds != 1 {
-        return Err(BakeError::invalid(obj, "polygon/point/direction", "a light needs exactly one of `polygon`, `point` or `direction`"));
+        return Err(BakeError::invalid(
+            obj,
+            "polygon/point/direction",
+            "a light needs exactly one of `polygon`, `point` or `direction`",
+        ));
     }
     let kind = if let Some(poly) = &l.polygon {
-        let radiance = check_color(obj, "radiance", l.radiance.ok_or_else(|| BakeError::invalid(obj, "radiance", "an area light needs `radiance`"))?, MAX_RADIANCE)?;
+        let radiance = check_color(
+            obj,
+            "radiance",
+            l.radiance.ok_or_else(|| {
+                BakeError::invalid(obj, "radiance", "an area light needs `radiance`")
+            })?,
+            MAX_RADIANCE,
+        )?;
         if poly.len() < 3 {
-            return Err(BakeError::invalid(obj, "polygon", format!("has {} vertices, needs at least 3", poly.len())));
+            return Err(BakeError::invalid(
+                obj,
+                "polygon",
+                format!("has {} vertices, needs at least 3", poly.len()),
+            ));
         }
-        let verts: Vec<DVec3> =
-            poly.iter().enumerate().map(|(i, p)| check_point(obj, &format!("polygon[{i}]"), *p)).collect::<Result<_, _>>()?;
+        let verts: Vec<DVec3> = poly
+            .iter()
+            .enumerate()
+            .map(|(i, p)| check_point(obj, &format!("polygon[{i}]"), *p))
+            .collect::<Result<_, _>>()?;
         let pieces = convex_pieces(&verts);
         if pieces.is_empty() {
-            return Err(BakeError::invalid(obj, "polygon", "has zero area (degenerate light)"));
+            return Err(BakeError::invalid(
+                obj,
+                "polygon",
+                "has zero area (degenerate light)",
+            ));
         }
         if pieces.len() > 1 || pieces[0].len() < verts.len() - count_collinear(&verts) {
-            return Err(BakeError::invalid(obj, "polygon", "must be a convex planar polygon (split it into several lights)"));
+            return Err(BakeError::invalid(
+                obj,
+                "polygon",
+                "must be a convex planar polygon (split it into several lights)",
+            ));
         }
         let verts = pieces.into_iter().next().unwrap();
         let plane = Plane::from_polygon(&verts).expect("non-degenerate");
-        LightKind::Area { verts, plane, radiance }
+        LightKind::Area {
+            verts,
+            plane,
+            radiance,
+        }
     } else if let Some(p) = l.point {
         let position = check_point(obj, "point", p)?;
-        let intensity = check_color(obj, "intensity", l.intensity.ok_or_else(|| BakeError::invalid(obj, "intensity", "a point light needs `intensity`"))?, MAX_RADIANCE)?;
+        let intensity = check_color(
+            obj,
+            "intensity",
+            l.intensity.ok_or_else(|| {
+                BakeError::invalid(obj, "intensity", "a point light needs `intensity`")
+            })?,
+            MAX_RADIANCE,
+        )?;
         let spot = match &l.spot {
             None => None,
             Some(s) => {
                 let d = check_point(obj, "spot.direction", s.direction)?;
                 if d.length() == 0.0 {
-                    return Err(BakeError::invalid(obj, "spot.direction", "is the zero vector"));
+                    return Err(BakeError::invalid(
+                        obj,
+                        "spot.direction",
+                        "is the zero vector",
+                    ));
                 }
                 if !(s.angle.is_finite() && s.angle > 0.0 && s.angle <= std::f64::consts::PI) {
-                    return Err(BakeError::invalid(obj, "spot.angle", format!("{} must be in (0, π]", s.angle)));
+                    return Err(BakeError::invalid(
+                        obj,
+                        "spot.angle",
+                        format!("{} must be in (0, π]", s.angle),
+                    ));
                 }
                 if !(s.blend.is_finite() && (0.0..=1.0).contains(&s.blend)) {
-                    return Err(BakeError::invalid(obj, "spot.blend", format!("{} must be in [0, 1]", s.blend)));
+                    return Err(BakeError::invalid(
+                        obj,
+                        "spot.blend",
+                        format!("{} must be in [0, 1]", s.blend),
+                    ));
                 }
-                Some(Spot { direction: d.normalize(), cos_half_angle: (s.angle * 0.5).cos(), blend: s.blend })
+                Some(Spot {
+                    direction: d.normalize(),
+                    cos_half_angle: (s.angle * 0.5).cos(),
+                    blend: s.blend,
+                })
             }
         };
-        LightKind::Point { position, intensity, spot }
+        LightKind::Point {
+            position,
+            intensity,
+            spot,
+        }
     } else {
         let d = check_point(obj, "direction", l.direction.unwrap())?;
         if d.length() == 0.0 {
             return Err(BakeError::invalid(obj, "direction", "is the zero vector"));
         }
-        let irradiance = check_color(obj, "irradiance", l.irradiance.ok_or_else(|| BakeError::invalid(obj, "irradiance", "a sun light needs `irradiance`"))?, MAX_RADIANCE)?;
-        LightKind::Sun { direction: d.normalize(), irradiance }
+        let irradiance = check_color(
+            obj,
+            "irradiance",
+            l.irradiance.ok_or_else(|| {
+                BakeError::invalid(obj, "irradiance", "a sun light needs `irradiance`")
+            })?,
+            MAX_RADIANCE,
+        )?;
+        LightKind::Sun {
+            direction: d.normalize(),
+            irradiance,
+        }
     };
-    Ok(Light { name: l.name.clone(), index: li, kind })
+    Ok(Light {
+        name: l.name.clone(),
+        index: li,
+        kind,
+    })
 }
 
 /// Vertices that lie on the line through their neighbours: they vanish in a convex piece

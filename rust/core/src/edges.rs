@@ -1,0 +1,296 @@
+//! Stage 3 (paper 2.2): discontinuity edges. Every shadow volume is intersected with the
+//! receivers it can reach (found through a box tree, never all pairs); on a receiver the
+//! intersection is a convex polygon in the receiver's 2-D frame, whose edges are the
+//! discontinuity edges.
+
+use glam::{DVec2, DVec3};
+use rayon::prelude::*;
+
+use crate::geom::bvh::{Aabb, BoxTree};
+use crate::geom::polygon::{
+    clip_polygon_2d, clip_polygon_3d, signed_area_2d, simplify_convex, HalfPlane,
+};
+use crate::geom::{Frame, Plane};
+use crate::scene::{Face, LightKind, Scene};
+use crate::shadow::{shadow_volumes, ShadowVolumes, Volume};
+
+/// `occluder` value of the polygon that marks the part of a receiver behind an area light's
+/// plane (the light emits nothing there).
+pub const BEHIND_LIGHT: u32 = u32::MAX;
+
+/// A shadow volume cut down to one receiver.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShadowPolygon {
+    pub light: u32,
+    pub occluder: u32,
+    pub umbra: bool,
+    /// From a point or sun light: its boundary is a D0 discontinuity.
+    pub hard: bool,
+    /// Convex, counter-clockwise, in the receiver's frame.
+    pub poly: Vec<DVec2>,
+}
+
+/// How one light stands to one receiver as a whole.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Exposure {
+    /// The light cannot reach the receiver's front anywhere.
+    Hidden,
+    /// Regions decide (shadow polygons).
+    Regions,
+}
+
+/// Everything the later stages need about the shadows on one receiver.
+#[derive(Debug, Clone)]
+pub struct ReceiverShadows {
+    pub face: u32,
+    pub exposure: Vec<Exposure>,
+    pub polys: Vec<ShadowPolygon>,
+    /// Occluder edges lying on the receiver (contact lines), in its frame: light jumps
+    /// across them (D0), so the mesh must not share vertices there.
+    pub contacts: Vec<[DVec2; 2]>,
+}
+
+/// Restricts a 3-D half-space to the receiver's plane: a 2-D half-plane in its frame, or
+/// all (`Ok(None)`) / nothing (`Err(())`) when the planes are parallel.
+fn restrict(h: &Plane, f: &Frame, eps: f64) -> Result<Option<HalfPlane>, ()> {
+    let n = DVec2::new(h.n.dot(f.u), h.n.dot(f.v));
+    let c = h.d - h.n.dot(f.origin);
+    if n.length() <= 1e-14 {
+        return if -c >= -eps { Ok(None) } else { Err(()) };
+    }
+    Ok(Some(HalfPlane { n, c }))
+}
+
+/// The part of receiver `r` inside `vol`, or `None` if it has no area.
+pub fn clip_to_volume(r: &Face, vol: &Volume, eps: f64) -> Option<Vec<DVec2>> {
+    let mut poly = r.poly2.clone();
+    for h in &vol.planes {
+        match restrict(h, &r.frame, eps) {
+            Err(()) => return None,
+            Ok(None) => {}
+            Ok(Some(hp)) => {
+                poly = clip_polygon_2d(&poly, &hp, eps);
+                if poly.len() < 3 {
+                    return None;
+                }
+            }
+        }
+    }
+    let poly = simplify_convex(&poly);
+    if poly.len() < 3 || signed_area_2d(&poly) <= eps * eps {
+        return None;
+    }
+    Some(poly)
+}
+
+/// The light as the receiver's front half-space sees it: `None` when it is wholly behind.
+fn light_in_front(kind: &LightKind, r: &Face, eps: f64) -> Option<Option<Vec<DVec3>>> {
+    match kind {
+        LightKind::Area { verts, .. } => {
+            let clipped = clip_polygon_3d(verts, &r.plane, eps);
+            if clipped.len() < 3 || clipped.iter().all(|v| r.plane.dist(*v) <= eps) {
+                return None;
+            }
+            if clipped.len() == verts.len() && clipped.iter().zip(verts).all(|(a, b)| a == b) {
+                Some(None)
+            } else {
+                Some(Some(clipped))
+            }
+        }
+        LightKind::Point { position, .. } => (r.plane.dist(*position) > eps).then_some(None),
+        LightKind::Sun { direction, .. } => (r.plane.n.dot(*direction) < 0.0).then_some(None),
+    }
+}
+
+/// Stage timings and counts for `Stats`.
+#[derive(Debug, Clone, Default)]
+pub struct EdgeStats {
+    pub shadow_pairs: u64,
+    pub culled_pairs: u64,
+    pub t_sdw: f64,
+    pub t_isr: f64,
+}
+
+/// Shadow polygons on every receiver for every light.
+pub fn shadow_polygons(
+    scene: &Scene,
+    progress: &crate::Progress,
+) -> Result<(Vec<ReceiverShadows>, EdgeStats), crate::BakeError> {
+    let eps = 1e-12 * scene.diagonal().max(1e-300);
+    let faces = &scene.faces;
+    let tree = BoxTree::new(faces.iter().map(|f| Aabb::from_points(&f.verts)).collect());
+    let mut stats = EdgeStats::default();
+    let mut per_receiver: Vec<ReceiverShadows> = (0..faces.len())
+        .map(|i| ReceiverShadows {
+            face: i as u32,
+            exposure: vec![Exposure::Regions; scene.lights.len()],
+            polys: Vec::new(),
+            contacts: Vec::new(),
+        })
+        .collect();
+
+    for (li, light) in scene.lights.iter().enumerate() {
+        progress.check()?;
+        progress.set_fraction(li as f64 / scene.lights.len() as f64);
+        let t0 = std::time::Instant::now();
+        let volumes: Vec<Option<ShadowVolumes>> = faces
+            .par_iter()
+            .enumerate()
+            .map(|(oi, o)| shadow_volumes(&light.kind, None, oi as u32, o, eps))
+            .collect();
+        stats.shadow_pairs += volumes.iter().filter(|v| v.is_some()).count() as u64;
+        stats.culled_pairs += volumes.iter().filter(|v| v.is_none()).count() as u64;
+        // Which receivers each volume can reach, inverted to receiver → volumes.
+        let mut hits: Vec<Vec<u32>> = vec![Vec::new(); faces.len()];
+        let found: Vec<Vec<u32>> = volumes
+            .par_iter()
+            .map(|v| {
+                let mut out = Vec::new();
+                if let Some(v) = v {
+                    for p in &v.penumbra {
+                        tree.query_volume(&p.planes, eps, &mut out);
+                    }
+                    out.sort_unstable();
+                    out.dedup();
+                }
+                out
+            })
+            .collect();
+        for (oi, rs) in found.iter().enumerate() {
+            for &r in rs {
+                if r as usize != oi {
+                    hits[r as usize].push(oi as u32);
+                }
+            }
+        }
+        stats.t_sdw += t0.elapsed().as_secs_f64();
+
+        let t1 = std::time::Instant::now();
+        let results: Vec<(Exposure, Vec<ShadowPolygon>, Vec<[DVec2; 2]>)> = faces
+            .par_iter()
+            .enumerate()
+            .map(|(ri, r)| {
+                receiver_polygons(
+                    li as u32,
+                    &light.kind,
+                    ri,
+                    r,
+                    faces,
+                    &volumes,
+                    &hits[ri],
+                    eps,
+                )
+            })
+            .collect();
+        for (ri, (exp, polys, contacts)) in results.into_iter().enumerate() {
+            per_receiver[ri].exposure[li] = exp;
+            per_receiver[ri].polys.extend(polys);
+            for c in contacts {
+                if !per_receiver[ri].contacts.contains(&c) {
+                    per_receiver[ri].contacts.push(c);
+                }
+            }
+        }
+        stats.t_isr += t1.elapsed().as_secs_f64();
+    }
+    Ok((per_receiver, stats))
+}
+
+#[allow(clippy::too_many_arguments)]
+fn receiver_polygons(
+    li: u32,
+    kind: &LightKind,
+    ri: usize,
+    r: &Face,
+    faces: &[Face],
+    volumes: &[Option<ShadowVolumes>],
+    hits: &[u32],
+    eps: f64,
+) -> (Exposure, Vec<ShadowPolygon>, Vec<[DVec2; 2]>) {
+    let Some(clipped_light) = light_in_front(kind, r, eps) else {
+        return (Exposure::Hidden, Vec::new(), Vec::new());
+    };
+    let mut out = Vec::new();
+    let mut contacts = Vec::new();
+    let touch = 1e3 * eps;
+    if let LightKind::Area { plane, .. } = kind {
+        // Points of the receiver behind the light's plane get nothing from it.
+        if let Some(poly) = clip_to_volume(
+            r,
+            &Volume {
+                planes: vec![plane.flipped()],
+            },
+            eps,
+        ) {
+            if (signed_area_2d(&poly) - r.area).abs() <= 1e-12 * r.area {
+                return (Exposure::Hidden, Vec::new(), Vec::new());
+            }
+            out.push(ShadowPolygon {
+                light: li,
+                occluder: BEHIND_LIGHT,
+                umbra: true,
+                hard: false,
+                poly,
+            });
+        }
+    }
+    for &oi in hits {
+        let o = &faces[oi as usize];
+        // An occluder wholly on or behind the receiver's plane cannot come between it and
+        // light arriving at its front.
+        if o.verts.iter().all(|v| r.plane.dist(*v) <= eps) {
+            continue;
+        }
+        for i in 0..o.verts.len() {
+            let (a, b) = (o.verts[i], o.verts[(i + 1) % o.verts.len()]);
+            if r.plane.dist(a).abs() <= touch && r.plane.dist(b).abs() <= touch {
+                contacts.push([r.frame.to_2d(a), r.frame.to_2d(b)]);
+            }
+        }
+        let recomputed;
+        let sv = match &clipped_light {
+            None => match &volumes[oi as usize] {
+                Some(v) => v,
+                None => continue,
+            },
+            Some(lv) => {
+                recomputed = shadow_volumes(kind, Some(lv), oi, o, eps);
+                match &recomputed {
+                    Some(v) => v,
+                    None => continue,
+                }
+            }
+        };
+        let _ = ri;
+        for p in &sv.penumbra {
+            if let Some(poly) = clip_to_volume(r, p, eps) {
+                out.push(ShadowPolygon {
+                    light: li,
+                    occluder: oi,
+                    umbra: false,
+                    hard: sv.hard,
+                    poly,
+                });
+            }
+        }
+        if let Some(u) = &sv.umbra {
+            if sv.hard {
+                // Point/sun: the same polygon is both; mark the one already pushed.
+                if let Some(last) = out.last_mut() {
+                    if last.occluder == oi {
+                        last.umbra = true;
+                    }
+                }
+            } else if let Some(poly) = clip_to_volume(r, u, eps) {
+                out.push(ShadowPolygon {
+                    light: li,
+                    occluder: oi,
+                    umbra: true,
+                    hard: false,
+                    poly,
+                });
+            }
+        }
+    }
+    (Exposure::Regions, out, contacts)
+}

@@ -1,0 +1,367 @@
+//! Stage 6 (paper 2.5): elements. Per receiver, a constrained Delaunay triangulation (spade)
+//! that conforms to every kept discontinuity edge and the receiver boundary. Nodes are seeded
+//! on a lattice whose spacing depends on the region (fine only in penumbra), then Delaunay
+//! refinement fixes angles. Edges across which some light jumps from lit to umbra (D0:
+//! contact shadows, point-light shadows) get two vertex rows, one per side.
+
+use std::collections::HashMap;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use glam::DVec2;
+use spade::handles::FixedVertexHandle;
+use spade::{
+    AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation,
+};
+
+use crate::arrangement::ArrFace;
+use crate::edges::ReceiverShadows;
+use crate::geom::polygon::orient;
+use crate::regions::{classify_point, ReceiverRegions, RegionFace};
+use crate::relation::Relation;
+use crate::settings::Settings;
+use crate::BakeError;
+
+/// The element mesh of one receiver, in its 2-D frame.
+#[derive(Debug, Clone, Default)]
+pub struct ReceiverMesh {
+    pub positions: Vec<DVec2>,
+    /// Where lighting is evaluated: the position, except on D0 rows, where it is moved a
+    /// hair into the vertex's own side so that it takes that side's limit value.
+    pub eval: Vec<DVec2>,
+    pub triangles: Vec<[u32; 3]>,
+    pub tri_region: Vec<u32>,
+    pub regions: Vec<RegionFace>,
+}
+
+type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
+
+/// Meshes one receiver. `budget` counts vertices over the whole scene so that a bake that
+/// would exceed `max_elements` stops early with a clear error.
+pub fn mesh_receiver(
+    rr: &ReceiverRegions,
+    sh: &ReceiverShadows,
+    settings: &Settings,
+    budget: &AtomicU64,
+) -> Result<ReceiverMesh, BakeError> {
+    let arr = &rr.arrangement;
+    let mut cdt = Cdt::new();
+    let mut handle: HashMap<u32, FixedVertexHandle> = HashMap::new();
+    let mut vh = |cdt: &mut Cdt, v: u32| -> Option<FixedVertexHandle> {
+        if let Some(h) = handle.get(&v) {
+            return Some(*h);
+        }
+        let p = arr.vertices[v as usize];
+        let h = cdt.insert(Point2::new(p.x, p.y)).ok()?;
+        handle.insert(v, h);
+        Some(h)
+    };
+    for &e in &rr.kept_edges {
+        let [a, b] = arr.edges[e as usize].v;
+        let (Some(ha), Some(hb)) = (vh(&mut cdt, a), vh(&mut cdt, b)) else {
+            continue;
+        };
+        if ha != hb {
+            cdt.add_constraint_and_split(ha, hb, |p| p);
+        }
+    }
+
+    // Seed nodes: a lattice per face, spaced by the face's relation.
+    let fine = settings.penumbra_element_size;
+    let coarse = settings.element_size;
+    let mut seeds = Vec::new();
+    for (f, rf) in arr.faces.iter().zip(&rr.faces) {
+        let h = if rf.relations.iter().any(|r| *r == Relation::Penumbra) {
+            fine
+        } else {
+            coarse
+        };
+        lattice_in_face(&arr.vertices, f, h, &mut seeds);
+    }
+    let used = budget.fetch_add(seeds.len() as u64 + handle.len() as u64, Ordering::Relaxed)
+        + seeds.len() as u64;
+    if used > settings.max_elements {
+        return Err(BakeError::setting(
+            "penumbra_element_size",
+            format!(
+                "the mesh would exceed max_elements = {} (raise element sizes or max_elements)",
+                settings.max_elements
+            ),
+        ));
+    }
+    for p in seeds {
+        let _ = cdt.insert(Point2::new(p.x, p.y));
+    }
+    let coarse_area = 0.433 * coarse * coarse;
+    let fine_area = 0.433 * fine * fine;
+    let extra =
+        (settings.max_elements.saturating_sub(used) as usize).min(cdt.num_vertices() * 4 + 64);
+    cdt.refine(
+        RefinementParameters::new()
+            .with_angle_limit(AngleLimit::from_deg(settings.min_angle))
+            .with_max_allowed_area(coarse_area * 1.5)
+            .with_min_required_area(fine_area * 0.02)
+            .with_max_additional_vertices(extra),
+    );
+    budget.fetch_add(
+        cdt.num_vertices() as u64 - handle.len() as u64,
+        Ordering::Relaxed,
+    );
+    Ok(extract(&cdt, sh))
+}
+
+/// Triangular lattice points strictly inside `f`, at least 0.35·h from its boundary.
+fn lattice_in_face(verts: &[DVec2], f: &ArrFace, h: f64, out: &mut Vec<DVec2>) {
+    let mut lo = DVec2::splat(f64::INFINITY);
+    let mut hi = DVec2::splat(f64::NEG_INFINITY);
+    for &v in &f.outer {
+        lo = lo.min(verts[v as usize]);
+        hi = hi.max(verts[v as usize]);
+    }
+    if f.area < 0.2 * h * h {
+        return;
+    }
+    let dy = h * 0.866_025_403_784_438_6;
+    let j0 = (lo.y / dy).floor() as i64;
+    let j1 = (hi.y / dy).ceil() as i64;
+    let i0 = (lo.x / h).floor() as i64 - 1;
+    let i1 = (hi.x / h).ceil() as i64 + 1;
+    let loops: Vec<&Vec<u32>> = std::iter::once(&f.outer).chain(f.holes.iter()).collect();
+    let clearance = 0.35 * h;
+    for j in j0..=j1 {
+        let y = j as f64 * dy;
+        let off = if j.rem_euclid(2) == 1 { 0.5 * h } else { 0.0 };
+        for i in i0..=i1 {
+            let p = DVec2::new(i as f64 * h + off, y);
+            if p.x < lo.x || p.x > hi.x || p.y < lo.y || p.y > hi.y {
+                continue;
+            }
+            if winding(verts, &f.outer, p) == 0
+                || f.holes.iter().any(|hl| winding(verts, hl, p) != 0)
+            {
+                continue;
+            }
+            let near = loops.iter().any(|l| {
+                (0..l.len()).any(|k| {
+                    seg_dist(
+                        verts[l[k] as usize],
+                        verts[l[(k + 1) % l.len()] as usize],
+                        p,
+                    ) < clearance
+                })
+            });
+            if !near {
+                out.push(p);
+            }
+        }
+    }
+}
+
+/// Winding number of the closed loop around `p` (exact orientation tests).
+fn winding(verts: &[DVec2], l: &[u32], p: DVec2) -> i32 {
+    let mut w = 0;
+    for k in 0..l.len() {
+        let a = verts[l[k] as usize];
+        let b = verts[l[(k + 1) % l.len()] as usize];
+        if a.y <= p.y {
+            if b.y > p.y && orient(a, b, p) > 0.0 {
+                w += 1;
+            }
+        } else if b.y <= p.y && orient(a, b, p) < 0.0 {
+            w -= 1;
+        }
+    }
+    w
+}
+
+fn seg_dist(a: DVec2, b: DVec2, p: DVec2) -> f64 {
+    let d = b - a;
+    let t = if d.length_squared() > 0.0 {
+        ((p - a).dot(d) / d.length_squared()).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (a + d * t - p).length()
+}
+
+/// Triangles, their regions (connected components across non-constraint edges, classified
+/// once each), and the D0 vertex split.
+fn extract(cdt: &Cdt, sh: &ReceiverShadows) -> ReceiverMesh {
+    let nv = cdt.num_vertices();
+    let mut positions: Vec<DVec2> = cdt
+        .vertices()
+        .map(|v| DVec2::new(v.position().x, v.position().y))
+        .collect();
+    let faces: Vec<_> = cdt.inner_faces().collect();
+    let face_index: HashMap<_, usize> = faces
+        .iter()
+        .enumerate()
+        .map(|(i, f)| (f.fix(), i))
+        .collect();
+    let mut triangles: Vec<[u32; 3]> = faces
+        .iter()
+        .map(|f| f.vertices().map(|v| v.fix().index() as u32))
+        .collect();
+
+    // Components across unconstrained edges.
+    let mut comp = vec![u32::MAX; faces.len()];
+    let mut regions: Vec<RegionFace> = Vec::new();
+    for start in 0..faces.len() {
+        if comp[start] != u32::MAX {
+            continue;
+        }
+        let id = regions.len() as u32;
+        let mut stack = vec![start];
+        comp[start] = id;
+        let mut best = (0.0f64, start);
+        while let Some(i) = stack.pop() {
+            let area = faces[i].area();
+            if area > best.0 {
+                best = (area, i);
+            }
+            for e in faces[i].adjacent_edges() {
+                if e.is_constraint_edge() {
+                    continue;
+                }
+                if let Some(nb) = e.rev().face().as_inner() {
+                    let j = face_index[&nb.fix()];
+                    if comp[j] == u32::MAX {
+                        comp[j] = id;
+                        stack.push(j);
+                    }
+                }
+            }
+        }
+        let c = faces[best.1].center();
+        regions.push(classify_point(sh, DVec2::new(c.x, c.y)));
+    }
+
+    // D0 split: group the triangles around each vertex into sectors that do not cross a
+    // lit|umbra edge; every sector but the first gets its own copy of the vertex.
+    let lit_umbra = |a: &RegionFace, b: &RegionFace| {
+        a.relations.iter().zip(&b.relations).any(|(x, y)| {
+            matches!(
+                (x, y),
+                (Relation::Lit, Relation::Umbra) | (Relation::Umbra, Relation::Lit)
+            )
+        })
+    };
+    let scale = positions
+        .iter()
+        .fold(0.0f64, |m, p| m.max(p.abs().max_element()))
+        .max(1e-300);
+    let on_contact = |p: DVec2, q: DVec2| {
+        sh.contacts
+            .iter()
+            .any(|&[a, b]| seg_dist(a, b, p) <= 1e-9 * scale && seg_dist(a, b, q) <= 1e-9 * scale)
+    };
+    let is_d0_edge = |e: spade::handles::DirectedEdgeHandle<
+        '_,
+        Point2<f64>,
+        (),
+        spade::CdtEdge<()>,
+        (),
+    >|
+     -> bool {
+        if !e.is_constraint_edge() {
+            return false;
+        }
+        let (Some(fa), Some(fb)) = (e.face().as_inner(), e.rev().face().as_inner()) else {
+            return false;
+        };
+        let (ca, cb) = (comp[face_index[&fa.fix()]], comp[face_index[&fb.fix()]]);
+        if ca == cb {
+            return false;
+        }
+        if lit_umbra(&regions[ca as usize], &regions[cb as usize]) {
+            return true;
+        }
+        let (p, q) = (e.from().position(), e.to().position());
+        on_contact(DVec2::new(p.x, p.y), DVec2::new(q.x, q.y))
+    };
+    let mut d0_vertices = Vec::new();
+    for e in cdt.undirected_edges() {
+        if !e.is_constraint_edge() {
+            continue;
+        }
+        let d = e.as_directed();
+        if is_d0_edge(d) {
+            d0_vertices.push(d.from().fix());
+            d0_vertices.push(d.to().fix());
+        }
+    }
+    let mut eval = positions.clone();
+    d0_vertices.sort_unstable();
+    d0_vertices.dedup();
+    for vh in d0_vertices {
+        let v = cdt.vertex(vh);
+        // Outgoing edges in order around the vertex; faces between consecutive edges.
+        let out: Vec<_> = v.out_edges().collect();
+        let n = out.len();
+        let mut sectors: Vec<Vec<usize>> = Vec::new();
+        let mut current: Vec<usize> = Vec::new();
+        // Start the walk just after a D0 edge so sectors do not wrap.
+        let cut = |k: usize| -> bool { is_d0_edge(out[k]) };
+        let Some(first_cut) = (0..n).find(|&k| cut(k)) else {
+            continue;
+        };
+        for s in 0..n {
+            let k = (first_cut + s) % n;
+            if s > 0 && cut(k) && !current.is_empty() {
+                sectors.push(std::mem::take(&mut current));
+            }
+            if let Some(f) = out[k].face().as_inner() {
+                current.push(face_index[&f.fix()]);
+            }
+        }
+        if !current.is_empty() {
+            sectors.push(current);
+        }
+        for (k, sector) in sectors.iter().enumerate() {
+            let id = if k == 0 {
+                vh.index() as u32
+            } else {
+                positions.push(positions[vh.index()]);
+                eval.push(positions[vh.index()]);
+                positions.len() as u32 - 1
+            };
+            // Nudge the evaluation point towards the sector's triangles.
+            let p = positions[vh.index()];
+            let mut dir = DVec2::ZERO;
+            let mut shortest = f64::INFINITY;
+            for &t in sector {
+                let c = triangles[t]
+                    .iter()
+                    .map(|&i| positions[i as usize])
+                    .sum::<DVec2>()
+                    / 3.0;
+                dir += (c - p).normalize_or_zero();
+                for &i in &triangles[t] {
+                    let d = (positions[i as usize] - p).length();
+                    if d > 0.0 {
+                        shortest = shortest.min(d);
+                    }
+                }
+            }
+            if dir != DVec2::ZERO && shortest.is_finite() {
+                eval[id as usize] = p + dir.normalize() * (shortest * 1e-6);
+            }
+            if k > 0 {
+                for &t in sector {
+                    for x in triangles[t].iter_mut() {
+                        if *x == vh.index() as u32 {
+                            *x = id;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let _ = nv;
+    ReceiverMesh {
+        positions,
+        eval,
+        triangles,
+        tri_region: comp,
+        regions,
+    }
+}

@@ -1,0 +1,235 @@
+//! Stages 4–5 (paper 2.3–2.4): per receiver, the arrangement of discontinuity edges and the
+//! receiver boundary, split into faces bounded by loops, each with its relation to every
+//! light. Edges that separate two faces which are both in umbra of every light that made the
+//! edge are no discontinuity at all (the mosaic of one closed mesh's face shadows inside its
+//! umbra); they are dropped, so that the mesh conforms only to real boundaries.
+
+use glam::DVec2;
+
+use crate::arrangement::{self, Arrangement, Segment, BOUNDARY_TAG};
+use crate::edges::{Exposure, ReceiverShadows, ShadowPolygon};
+use crate::geom::polygon::inside_convex;
+use crate::relation::Relation;
+use crate::scene::Face;
+
+/// A face of the arrangement with its light relations.
+#[derive(Debug, Clone)]
+pub struct RegionFace {
+    pub relations: Vec<Relation>,
+    /// Per light: occluders whose penumbra polygon contains the face.
+    pub blockers: Vec<Vec<u32>>,
+}
+
+/// The receiver split into faces, with the edges that the mesh must conform to.
+#[derive(Debug, Clone)]
+pub struct ReceiverRegions {
+    pub face: u32,
+    pub arrangement: Arrangement,
+    pub faces: Vec<RegionFace>,
+    /// Arrangement edges kept as discontinuities (plus boundary edges).
+    pub kept_edges: Vec<u32>,
+    /// Discontinuity edges kept (boundary excluded): the paper's N_d.
+    pub n_discontinuity: u64,
+    /// Faces after merging across dropped edges: the paper's N_f2.
+    pub n_regions: u64,
+}
+
+/// Bounding boxes of shadow polygons, for a cheap first test.
+struct Indexed<'a> {
+    polys: &'a [ShadowPolygon],
+    boxes: Vec<(DVec2, DVec2)>,
+}
+
+impl<'a> Indexed<'a> {
+    fn new(polys: &'a [ShadowPolygon]) -> Self {
+        let boxes = polys
+            .iter()
+            .map(|p| {
+                let mut lo = DVec2::splat(f64::INFINITY);
+                let mut hi = DVec2::splat(f64::NEG_INFINITY);
+                for q in &p.poly {
+                    lo = lo.min(*q);
+                    hi = hi.max(*q);
+                }
+                (lo, hi)
+            })
+            .collect();
+        Indexed { polys, boxes }
+    }
+
+    /// Relation and blockers of the point `q` (strictly inside some arrangement face).
+    pub fn classify(&self, q: DVec2, exposure: &[Exposure]) -> RegionFace {
+        let n = exposure.len();
+        let mut relations = vec![Relation::Lit; n];
+        let mut blockers = vec![Vec::new(); n];
+        for (l, e) in exposure.iter().enumerate() {
+            if *e == Exposure::Hidden {
+                relations[l] = Relation::Umbra;
+            }
+        }
+        for (p, (lo, hi)) in self.polys.iter().zip(&self.boxes) {
+            let l = p.light as usize;
+            if relations[l] == Relation::Umbra
+                || q.x < lo.x
+                || q.y < lo.y
+                || q.x > hi.x
+                || q.y > hi.y
+            {
+                continue;
+            }
+            if !inside_convex(&p.poly, q) {
+                continue;
+            }
+            if p.umbra {
+                relations[l] = Relation::Umbra;
+                blockers[l].clear();
+            } else {
+                relations[l] = Relation::Penumbra;
+                blockers[l].push(p.occluder);
+            }
+        }
+        for b in &mut blockers {
+            b.sort_unstable();
+            b.dedup();
+        }
+        RegionFace {
+            relations,
+            blockers,
+        }
+    }
+}
+
+/// Relation of a point to all lights, from the receiver's shadow polygons (exact tests).
+pub fn classify_point(sh: &ReceiverShadows, q: DVec2) -> RegionFace {
+    Indexed::new(&sh.polys).classify(q, &sh.exposure)
+}
+
+pub struct RegionTimes {
+    pub t_idd: f64,
+    pub t_lop: f64,
+    pub t_lit: f64,
+    pub t_div: f64,
+}
+
+pub fn build_regions(r: &Face, sh: &ReceiverShadows, diag: f64) -> (ReceiverRegions, RegionTimes) {
+    let t0 = std::time::Instant::now();
+    let mut segs = Vec::new();
+    for (k, p) in sh.polys.iter().enumerate() {
+        for i in 0..p.poly.len() {
+            let a = p.poly[i];
+            let b = p.poly[(i + 1) % p.poly.len()];
+            if a != b && !on_boundary(&r.poly2, a, b, 1e-10 * diag) {
+                segs.push(Segment {
+                    a,
+                    b,
+                    tag: k as u32,
+                });
+            }
+        }
+    }
+    let t_idd = t0.elapsed().as_secs_f64();
+    let t1 = std::time::Instant::now();
+    let extent = r
+        .poly2
+        .iter()
+        .map(|p| (*p - r.poly2[0]).length())
+        .fold(0.0, f64::max)
+        .max(diag * 1e-9);
+    let arr = arrangement::build(&r.poly2, &segs, 1e-9 * extent);
+    let t_lop = t1.elapsed().as_secs_f64();
+
+    let t2 = std::time::Instant::now();
+    let index = Indexed::new(&sh.polys);
+    let faces: Vec<RegionFace> = arr
+        .faces
+        .iter()
+        .map(|f| index.classify(f.interior, &sh.exposure))
+        .collect();
+    let t_lit = t2.elapsed().as_secs_f64();
+
+    let t3 = std::time::Instant::now();
+    // Which faces lie on each side of each edge.
+    let mut sides: Vec<[u32; 2]> = vec![[u32::MAX; 2]; arr.edges.len()];
+    for (fi, f) in arr.faces.iter().enumerate() {
+        for &e in &f.boundary_edges {
+            let s = &mut sides[e as usize];
+            if s[0] == u32::MAX {
+                s[0] = fi as u32;
+            } else if s[1] == u32::MAX {
+                s[1] = fi as u32;
+            }
+        }
+    }
+    let mut parent: Vec<u32> = (0..arr.faces.len() as u32).collect();
+    let mut kept = Vec::new();
+    let mut n_disc = 0u64;
+    for (ei, e) in arr.edges.iter().enumerate() {
+        if e.tags.contains(&BOUNDARY_TAG) {
+            kept.push(ei as u32);
+            continue;
+        }
+        let [a, b] = sides[ei];
+        let redundant = a != u32::MAX
+            && b != u32::MAX
+            && e.tags.iter().all(|&t| {
+                let l = sh.polys[t as usize].light as usize;
+                faces[a as usize].relations[l] == Relation::Umbra
+                    && faces[b as usize].relations[l] == Relation::Umbra
+            });
+        if redundant {
+            union(&mut parent, a, b);
+        } else if a != b {
+            kept.push(ei as u32);
+            n_disc += 1;
+        }
+    }
+    let n_regions = (0..parent.len() as u32)
+        .filter(|&i| find(&mut parent, i) == i)
+        .count() as u64;
+    let t_div = t3.elapsed().as_secs_f64();
+    (
+        ReceiverRegions {
+            face: sh.face,
+            arrangement: arr,
+            faces,
+            kept_edges: kept,
+            n_discontinuity: n_disc,
+            n_regions,
+        },
+        RegionTimes {
+            t_idd,
+            t_lop,
+            t_lit,
+            t_div,
+        },
+    )
+}
+
+/// Is segment a–b along an edge of the (convex) boundary? Such segments are the boundary
+/// itself, which the arrangement always has.
+fn on_boundary(poly: &[DVec2], a: DVec2, b: DVec2, tol: f64) -> bool {
+    (0..poly.len()).any(|i| {
+        let p = poly[i];
+        let q = poly[(i + 1) % poly.len()];
+        let d = q - p;
+        let len = d.length();
+        len > 0.0
+            && (d.perp_dot(a - p) / len).abs() <= tol
+            && (d.perp_dot(b - p) / len).abs() <= tol
+    })
+}
+
+fn find(p: &mut [u32], mut i: u32) -> u32 {
+    while p[i as usize] != i {
+        p[i as usize] = p[p[i as usize] as usize];
+        i = p[i as usize];
+    }
+    i
+}
+
+fn union(p: &mut [u32], a: u32, b: u32) {
+    let (ra, rb) = (find(p, a), find(p, b));
+    if ra != rb {
+        p[ra.max(rb) as usize] = ra.min(rb);
+    }
+}

@@ -1,0 +1,402 @@
+//! Stage 2 (paper 2.1): shadow volumes of every (light, occluder) pair that can cast a
+//! shadow, as intersections of half-spaces.
+//!
+//! For a convex light L and convex occluder O, the penumbra volume
+//! S = { p : some segment [p, l], l ∈ L, meets O } is convex (for any two points of S a
+//! convex combination of their witnesses is a witness for the midpoint). When L lies on one
+//! side of O's plane, S is bounded by the *separating* planes through an edge of one polygon
+//! and a vertex of the other (the extreme rays of the cone of separating planes, the paper's
+//! "largest angle" EV/VE planes), together with L's and O's own planes when they separate.
+//! The umbra U = { p : every such segment meets O } is the intersection of the point-light
+//! shadow volumes of L's vertices, because the cone from p through O is convex.
+//! A light that straddles O's plane is cut by it into two pieces, each with its own S on the
+//! far side of O; such a light has no umbra behind O alone.
+
+use glam::DVec3;
+use robust::{orient3d, Coord3D};
+
+use crate::geom::plane::newell_normal;
+use crate::geom::polygon::clip_polygon_3d;
+use crate::geom::Plane;
+use crate::scene::{Face, LightKind};
+
+/// Closed convex volume: the points with `plane.dist(p) >= 0` for every plane.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Volume {
+    pub planes: Vec<Plane>,
+}
+
+impl Volume {
+    pub fn contains(&self, p: DVec3, eps: f64) -> bool {
+        self.planes.iter().all(|h| h.dist(p) >= -eps)
+    }
+}
+
+/// Shadow volumes of one occluder for one light.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ShadowVolumes {
+    pub occluder: u32,
+    /// Partial or full shadow (one volume per side of the occluder the light is on).
+    pub penumbra: Vec<Volume>,
+    /// Full shadow; `None` when empty.
+    pub umbra: Option<Volume>,
+    /// Point and sun lights: umbra and penumbra coincide and the boundary is a D0 edge.
+    pub hard: bool,
+}
+
+#[inline]
+fn c3(p: DVec3) -> Coord3D<f64> {
+    Coord3D {
+        x: p.x,
+        y: p.y,
+        z: p.z,
+    }
+}
+
+/// Plane through a, b, c oriented so that `inside` is on its non-negative side; `None`
+/// when the three points are (nearly) collinear.
+fn oriented_plane(a: DVec3, b: DVec3, c: DVec3, inside: DVec3) -> Option<Plane> {
+    let n = (b - a).cross(c - a);
+    let scale = (b - a).length_squared().max((c - a).length_squared());
+    if !(n.length_squared() > 1e-24 * scale * scale) {
+        return None;
+    }
+    let p = Plane::from_point_normal(a, n);
+    Some(if p.dist(inside) < 0.0 { p.flipped() } else { p })
+}
+
+/// Exact side of `d` w.r.t. the plane through a, b, c (sign of robust orient3d).
+#[inline]
+fn side(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
+    orient3d(c3(a), c3(b), c3(c), c3(d))
+}
+
+/// Separating planes through an edge of `p` and a vertex of `q` (exact side tests): all of
+/// `p` on one closed side, all of `q` on the other. Each is oriented towards `o_side`'s
+/// polygon (`true` → towards q, else towards p).
+fn separating_planes(p: &[DVec3], q: &[DVec3], towards_q: bool, out: &mut Vec<Plane>) {
+    let cq = q.iter().copied().sum::<DVec3>() / q.len() as f64;
+    let cp = p.iter().copied().sum::<DVec3>() / p.len() as f64;
+    for i in 0..p.len() {
+        let a = p[i];
+        let b = p[(i + 1) % p.len()];
+        for &v in q {
+            // Sign of each polygon's vertices relative to plane (a, b, v).
+            let mut sp = 0i8;
+            let mut ok = true;
+            for &x in p {
+                let s = side(a, b, v, x);
+                if s != 0.0 {
+                    let sg = if s > 0.0 { 1 } else { -1 };
+                    if sp == 0 {
+                        sp = sg;
+                    } else if sp != sg {
+                        ok = false;
+                        break;
+                    }
+                }
+            }
+            if !ok {
+                continue;
+            }
+            let mut sq = 0i8;
+            for &x in q {
+                let s = side(a, b, v, x);
+                if s != 0.0 {
+                    let sg = if s > 0.0 { 1 } else { -1 };
+                    if sq == 0 {
+                        sq = sg;
+                    } else if sq != sg {
+                        ok = false;
+                        break;
+                    }
+                }
+            }
+            // Separating: strictly opposite sides (a polygon wholly in the plane is degenerate).
+            if !ok || sp == 0 || sq == 0 || sp == sq {
+                continue;
+            }
+            let target = if towards_q { cq } else { cp };
+            if let Some(pl) = oriented_plane(a, b, v, target) {
+                if !out.iter().any(|o| {
+                    (o.n - pl.n).length() < 1e-12 && (o.d - pl.d).abs() < 1e-12 * (1.0 + o.d.abs())
+                }) {
+                    out.push(pl);
+                }
+            }
+        }
+    }
+}
+
+/// The penumbra volume of light piece `l` (strictly on one side of `o`'s plane) and occluder `o`.
+fn penumbra_volume(l: &[DVec3], o: &[DVec3]) -> Volume {
+    let mut planes = Vec::new();
+    separating_planes(l, o, true, &mut planes);
+    separating_planes(o, l, false, &mut planes);
+    // The polygons' own planes, when they separate.
+    for (poly, other, towards_o) in [(l, o, true), (o, l, false)] {
+        let Some(pl) = Plane::from_polygon(poly) else {
+            continue;
+        };
+        let ds: Vec<f64> = other.iter().map(|x| pl.dist(*x)).collect();
+        let scale = other
+            .iter()
+            .chain(poly)
+            .map(|x| x.length())
+            .fold(1e-300, f64::max);
+        let tol = 1e-12 * scale;
+        let pos = ds.iter().all(|&d| d >= -tol);
+        let neg = ds.iter().all(|&d| d <= tol);
+        if pos == neg {
+            continue;
+        }
+        // Orient towards o when the plane is l's; towards the far side from l when it is o's.
+        let pl = if towards_o {
+            if pos {
+                pl
+            } else {
+                pl.flipped()
+            }
+        } else if pos {
+            pl.flipped()
+        } else {
+            pl
+        };
+        planes.push(pl);
+    }
+    Volume { planes }
+}
+
+/// Shadow volume of occluder `o` from point `l`: the cone from l through o, beyond o.
+fn point_volume(l: DVec3, o: &[DVec3], o_plane: &Plane) -> Option<Volume> {
+    let dl = o_plane.dist(l);
+    let scale = o.iter().map(|x| (*x - l).length()).fold(0.0, f64::max);
+    if dl.abs() <= 1e-12 * scale {
+        return None;
+    }
+    let c = o.iter().copied().sum::<DVec3>() / o.len() as f64;
+    let mut planes = Vec::with_capacity(o.len() + 1);
+    for i in 0..o.len() {
+        planes.push(oriented_plane(l, o[i], o[(i + 1) % o.len()], c)?);
+    }
+    planes.push(if dl > 0.0 {
+        o_plane.flipped()
+    } else {
+        *o_plane
+    });
+    Some(Volume { planes })
+}
+
+/// Shadow volume of occluder `o` under a directional light travelling along `dir`.
+fn sun_volume(dir: DVec3, o: &[DVec3], o_plane: &Plane) -> Option<Volume> {
+    let dn = o_plane.n.dot(dir);
+    if dn.abs() < 1e-12 {
+        return None;
+    }
+    let c = o.iter().copied().sum::<DVec3>() / o.len() as f64;
+    let mut planes = Vec::with_capacity(o.len() + 1);
+    for i in 0..o.len() {
+        let a = o[i];
+        let b = o[(i + 1) % o.len()];
+        planes.push(oriented_plane(
+            a,
+            b,
+            a + dir * (b - a).length().max(1e-300),
+            c,
+        )?);
+    }
+    // The shadow lies on the side the light travels into.
+    planes.push(if dn > 0.0 {
+        *o_plane
+    } else {
+        o_plane.flipped()
+    });
+    Some(Volume { planes })
+}
+
+/// Shadow volumes of `occluder` (face index `oi`) for a light of the given kind, or `None`
+/// when the pair cannot cast a shadow (occluder behind or in the light's plane).
+/// `eps` is the scene's length tolerance.
+pub fn shadow_volumes(
+    kind: &LightKind,
+    light_verts_override: Option<&[DVec3]>,
+    oi: u32,
+    occluder: &Face,
+    eps: f64,
+) -> Option<ShadowVolumes> {
+    match kind {
+        LightKind::Area { verts, plane, .. } => {
+            let lv = light_verts_override.unwrap_or(verts);
+            // Only the part of the occluder in front of the light can stand between it and a
+            // lit point.
+            let o = clip_polygon_3d(&occluder.verts, plane, eps);
+            if o.len() < 3 || o.iter().all(|x| plane.dist(*x) <= eps) {
+                return None;
+            }
+            let o_plane = Plane::from_polygon(&o).unwrap_or(occluder.plane);
+            let ds: Vec<f64> = lv.iter().map(|x| o_plane.dist(*x)).collect();
+            let above = ds.iter().any(|&d| d > eps);
+            let below = ds.iter().any(|&d| d < -eps);
+            let mut penumbra = Vec::new();
+            let mut umbra = None;
+            if above && below {
+                for pl in [o_plane, o_plane.flipped()] {
+                    let piece = clip_polygon_3d(lv, &pl, 0.0);
+                    if piece.len() >= 3 && newell_normal(&piece).length() > 0.0 {
+                        penumbra.push(penumbra_volume(&piece, &o));
+                    }
+                }
+            } else if above || below {
+                penumbra.push(penumbra_volume(lv, &o));
+                let mut planes = Vec::new();
+                let mut ok = true;
+                for &l in lv {
+                    match point_volume(l, &o, &o_plane) {
+                        Some(v) => planes.extend(v.planes),
+                        None => {
+                            ok = false;
+                            break;
+                        }
+                    }
+                }
+                if ok {
+                    planes.push(*plane);
+                    umbra = Some(Volume { planes });
+                }
+            } else {
+                return None;
+            }
+            Some(ShadowVolumes {
+                occluder: oi,
+                penumbra,
+                umbra,
+                hard: false,
+            })
+        }
+        LightKind::Point { position, .. } => {
+            let v = point_volume(*position, &occluder.verts, &occluder.plane)?;
+            Some(ShadowVolumes {
+                occluder: oi,
+                penumbra: vec![v.clone()],
+                umbra: Some(v),
+                hard: true,
+            })
+        }
+        LightKind::Sun { direction, .. } => {
+            let v = sun_volume(*direction, &occluder.verts, &occluder.plane)?;
+            Some(ShadowVolumes {
+                occluder: oi,
+                penumbra: vec![v.clone()],
+                umbra: Some(v),
+                hard: true,
+            })
+        }
+    }
+}
+
+#[cfg(test)]
+mod test {
+    use super::*;
+    use crate::geom::Frame;
+
+    pub(crate) fn square(c: DVec3, half: f64, up: bool) -> Vec<DVec3> {
+        let mut v = vec![
+            c + DVec3::new(-half, -half, 0.0),
+            c + DVec3::new(half, -half, 0.0),
+            c + DVec3::new(half, half, 0.0),
+            c + DVec3::new(-half, half, 0.0),
+        ];
+        if !up {
+            v.reverse();
+        }
+        v
+    }
+
+    pub(crate) fn face(verts: Vec<DVec3>) -> Face {
+        let plane = Plane::from_polygon(&verts).unwrap();
+        let frame = Frame::on_plane(&plane, verts[0]);
+        let poly2 = verts.iter().map(|v| frame.to_2d(*v)).collect();
+        Face {
+            mesh: 0,
+            source_polygon: 0,
+            verts,
+            plane,
+            frame,
+            poly2,
+            albedo: DVec3::ONE,
+            emission: DVec3::ZERO,
+            area: 0.0,
+        }
+    }
+
+    fn unit_light() -> LightKind {
+        let verts = square(DVec3::new(0., 0., 2.), 0.5, false);
+        let plane = Plane::from_polygon(&verts).unwrap();
+        LightKind::Area {
+            verts,
+            plane,
+            radiance: DVec3::ONE,
+        }
+    }
+
+    #[test]
+    fn square_over_floor_matches_similar_triangles() {
+        let occ = face(square(DVec3::new(0., 0., 1.), 0.4, true));
+        let sv = shadow_volumes(&unit_light(), None, 0, &occ, 1e-12).unwrap();
+        let u = sv.umbra.as_ref().unwrap();
+        let s = &sv.penumbra[0];
+        let on_floor = |x: f64, y: f64| DVec3::new(x, y, 0.0);
+        // Umbra |x|,|y| ≤ 0.3; penumbra |x|,|y| < 1.3.
+        assert!(u.contains(on_floor(0.299, 0.299), 0.0));
+        assert!(!u.contains(on_floor(0.301, 0.0), 0.0));
+        assert!(s.contains(on_floor(1.299, 0.0), 0.0));
+        assert!(!s.contains(on_floor(1.301, 0.0), 0.0));
+        assert!(s.contains(on_floor(1.29, 1.29), 0.0));
+        // Nothing above the occluder is shadowed.
+        assert!(!s.contains(DVec3::new(0., 0., 1.5), 0.0));
+    }
+
+    #[test]
+    fn occluder_behind_light_casts_nothing() {
+        let occ = face(square(DVec3::new(0., 0., 3.), 0.4, true));
+        assert!(shadow_volumes(&unit_light(), None, 0, &occ, 1e-12).is_none());
+    }
+
+    #[test]
+    fn light_straddling_occluder_plane_has_no_umbra() {
+        // A vertical occluder through the light's centre line.
+        let occ = face(vec![
+            DVec3::new(0., -0.3, 0.5),
+            DVec3::new(0., 0.3, 0.5),
+            DVec3::new(0., 0.3, 2.5),
+            DVec3::new(0., -0.3, 2.5),
+        ]);
+        let sv = shadow_volumes(&unit_light(), None, 0, &occ, 1e-12).unwrap();
+        assert!(sv.umbra.is_none());
+        assert_eq!(sv.penumbra.len(), 2);
+        // Just beside the occluder's foot, on either side, light from the other half is cut.
+        assert!(sv
+            .penumbra
+            .iter()
+            .any(|v| v.contains(DVec3::new(0.05, 0.0, 0.0), 0.0)));
+        assert!(sv
+            .penumbra
+            .iter()
+            .any(|v| v.contains(DVec3::new(-0.05, 0.0, 0.0), 0.0)));
+    }
+
+    #[test]
+    fn point_light_volume_is_hard() {
+        let kind = LightKind::Point {
+            position: DVec3::new(0., 0., 2.),
+            intensity: DVec3::ONE,
+            spot: None,
+        };
+        let occ = face(square(DVec3::new(0., 0., 1.), 0.5, true));
+        let sv = shadow_volumes(&kind, None, 0, &occ, 1e-12).unwrap();
+        assert!(sv.hard);
+        let u = sv.umbra.unwrap();
+        assert!(u.contains(DVec3::new(0.99, 0.0, 0.0), 0.0));
+        assert!(!u.contains(DVec3::new(1.01, 0.0, 0.0), 0.0));
+    }
+}

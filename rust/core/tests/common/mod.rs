@@ -1,0 +1,277 @@
+//! Scene builders shared by the integration tests.
+#![allow(dead_code)]
+
+use glam::DVec3;
+use penumbra::geom::polygon::clip_polygon_3d;
+use penumbra::geom::Plane;
+use penumbra::scene::json::{LightJson, MeshJson, SceneJson, SettingsJson};
+use penumbra::{Bake, Progress};
+
+pub fn quad(c: [f64; 3], hx: f64, hy: f64, up: bool) -> Vec<[f64; 3]> {
+    let mut v = vec![
+        [c[0] - hx, c[1] - hy, c[2]],
+        [c[0] + hx, c[1] - hy, c[2]],
+        [c[0] + hx, c[1] + hy, c[2]],
+        [c[0] - hx, c[1] + hy, c[2]],
+    ];
+    if !up {
+        v.reverse();
+    }
+    v
+}
+
+pub fn mesh(name: &str, polys: Vec<Vec<[f64; 3]>>) -> MeshJson {
+    let mut positions = Vec::new();
+    let mut polygons = Vec::new();
+    for p in polys {
+        let start = positions.len() as i64;
+        polygons.push((0..p.len() as i64).map(|i| start + i).collect());
+        positions.extend(p);
+    }
+    MeshJson {
+        name: name.into(),
+        positions,
+        polygons,
+        albedo: None,
+        emission: None,
+    }
+}
+
+pub fn area_light(name: &str, polygon: Vec<[f64; 3]>) -> LightJson {
+    LightJson {
+        name: name.into(),
+        polygon: Some(polygon),
+        radiance: Some([1.0; 3]),
+        ..Default::default()
+    }
+}
+
+pub fn point_light(name: &str, p: [f64; 3]) -> LightJson {
+    LightJson {
+        name: name.into(),
+        point: Some(p),
+        intensity: Some([1.0; 3]),
+        ..Default::default()
+    }
+}
+
+pub fn scene(meshes: Vec<MeshJson>, lights: Vec<LightJson>, settings: SettingsJson) -> SceneJson {
+    SceneJson {
+        format: "penumbra-scene".into(),
+        version: 1,
+        meshes,
+        lights,
+        settings,
+    }
+}
+
+pub fn bake(s: &SceneJson) -> Bake {
+    let sc = penumbra::scene::validate(s).expect("valid scene");
+    penumbra::bake(&sc, &Progress::new()).expect("bake")
+}
+
+pub fn tri_area(p: &[[f64; 3]], t: [u32; 3]) -> f64 {
+    let a = glam::DVec3::from_array(p[t[0] as usize]);
+    let b = glam::DVec3::from_array(p[t[1] as usize]);
+    let c = glam::DVec3::from_array(p[t[2] as usize]);
+    (b - a).cross(c - a).length() * 0.5
+}
+
+pub struct Rng(pub u64);
+impl Rng {
+    pub fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+    pub fn range(&mut self, a: f64, b: f64) -> f64 {
+        a + (b - a) * self.next()
+    }
+}
+
+pub fn area3(p: &[DVec3]) -> f64 {
+    if p.len() < 3 {
+        return 0.0;
+    }
+    penumbra::geom::plane::newell_normal(p).length() * 0.5
+}
+
+/// The part of light polygon `l` hidden from `p` by convex polygon `o`: `l` clipped by the
+/// planes through p and each edge of o (o's side) and by o's plane (the side away from p).
+pub fn blocked(p: DVec3, l: &[DVec3], o: &[DVec3]) -> Vec<DVec3> {
+    let Some(op) = Plane::from_polygon(o) else {
+        return vec![];
+    };
+    let dp = op.dist(p);
+    if dp.abs() < 1e-12 {
+        return vec![];
+    }
+    let c = o.iter().copied().sum::<DVec3>() / o.len() as f64;
+    let mut b = l.to_vec();
+    for i in 0..o.len() {
+        let n = (o[i] - p).cross(o[(i + 1) % o.len()] - p);
+        if n.length() == 0.0 {
+            return vec![];
+        }
+        let mut h = Plane::from_point_normal(p, n);
+        if h.dist(c) < 0.0 {
+            h = h.flipped();
+        }
+        b = clip_polygon_3d(&b, &h, 0.0);
+    }
+    let far = if dp > 0.0 { op.flipped() } else { op };
+    clip_polygon_3d(&b, &far, 0.0)
+}
+
+pub fn segment_hits(p: DVec3, q: DVec3, o: &[DVec3]) -> bool {
+    let Some(op) = Plane::from_polygon(o) else {
+        return false;
+    };
+    let (a, b) = (op.dist(p), op.dist(q));
+    if a * b >= 0.0 {
+        return false;
+    }
+    let x = p + (q - p) * (a / (a - b));
+    let n = op.n;
+    (0..o.len()).all(|i| (o[(i + 1) % o.len()] - o[i]).cross(x - o[i]).dot(n) >= 0.0)
+}
+
+/// Checks every triangle's relation codes against exact visibility at three interior
+/// points; returns how many (point, light) pairs had each code.
+pub fn check_relations(s: &SceneJson, b: &Bake, seed: u64) -> [usize; 4] {
+    let mut checked = [0usize; 4];
+    let polys: Vec<(usize, usize, Vec<DVec3>)> = s
+        .meshes
+        .iter()
+        .enumerate()
+        .flat_map(|(mi, m)| {
+            m.polygons.iter().enumerate().map(move |(pi, p)| {
+                (
+                    mi,
+                    pi,
+                    p.iter()
+                        .map(|&i| DVec3::from_array(m.positions[i as usize]))
+                        .collect(),
+                )
+            })
+        })
+        .collect();
+    for (mi, bm) in b.meshes.iter().enumerate() {
+        for (t, tri) in bm.triangles.iter().enumerate() {
+            let src = bm.source_polygon[t] as usize;
+            let recv = &polys
+                .iter()
+                .find(|(m, p, _)| *m == mi && *p == src)
+                .unwrap()
+                .2;
+            let rplane = Plane::from_polygon(recv).unwrap();
+            let v: Vec<DVec3> = tri
+                .iter()
+                .map(|&i| DVec3::from_array(bm.positions[i as usize]))
+                .collect();
+            if area3(&v) < 1e-10 {
+                continue;
+            }
+            for w in [
+                [1. / 3., 1. / 3., 1. / 3.],
+                [0.6, 0.2, 0.2],
+                [0.2, 0.2, 0.6],
+            ] {
+                let p = v[0] * w[0] + v[1] * w[1] + v[2] * w[2];
+                for (li, l) in s.lights.iter().enumerate() {
+                    let code = bm.relation[t][li];
+                    checked[code as usize] += 1;
+                    let occluders = polys.iter().filter(|(m, pi, _)| !(*m == mi && *pi == src));
+                    if let Some(pos) = l.point {
+                        let pos = DVec3::from_array(pos);
+                        let hidden = rplane.dist(pos) <= 0.0
+                            || occluders.clone().any(|(_, _, o)| segment_hits(p, pos, o));
+                        assert_eq!(
+                            code,
+                            if hidden { 3 } else { 1 },
+                            "seed {seed} mesh {mi} tri {t} point light"
+                        );
+                        continue;
+                    }
+                    let lv: Vec<DVec3> = l
+                        .polygon
+                        .as_ref()
+                        .unwrap()
+                        .iter()
+                        .map(|x| DVec3::from_array(*x))
+                        .collect();
+                    let lplane = Plane::from_polygon(&lv).unwrap();
+                    let lf = clip_polygon_3d(&lv, &rplane, 0.0);
+                    let la = area3(&lf);
+                    if la <= 1e-12 || lplane.dist(p) <= 0.0 {
+                        assert_eq!(code, 3, "seed {seed} mesh {mi} tri {t}: light behind");
+                        continue;
+                    }
+                    let hidden: Vec<f64> = occluders
+                        .map(|(_, _, o)| area3(&blocked(p, &lf, o)))
+                        .collect();
+                    let max = hidden.iter().cloned().fold(0.0, f64::max);
+                    match code {
+                            1 => assert!(max <= 1e-9 * la, "seed {seed} mesh {mi} tri {t} light {li}: lit but {max} of {la} hidden"),
+                            3 => assert!(max >= la * (1.0 - 1e-9), "seed {seed} mesh {mi} tri {t} light {li}: umbra but only {max} of {la} hidden"),
+                            2 => assert!(max > 0.0, "seed {seed} mesh {mi} tri {t} light {li}: penumbra but nothing hidden"),
+                            c => panic!("code {c}"),
+                        }
+                }
+            }
+        }
+    }
+    checked
+}
+
+/// The elements of every input polygon cover exactly its area, and no triangle is inverted
+/// relative to the polygon's facing.
+pub fn check_coverage(s: &SceneJson, b: &Bake) {
+    for (mi, m) in s.meshes.iter().enumerate() {
+        let bm = &b.meshes[mi];
+        let mut got = vec![0.0; m.polygons.len()];
+        for (t, tri) in bm.triangles.iter().enumerate() {
+            let v: Vec<DVec3> = tri
+                .iter()
+                .map(|&i| DVec3::from_array(bm.positions[i as usize]))
+                .collect();
+            let poly: Vec<DVec3> = m.polygons[bm.source_polygon[t] as usize]
+                .iter()
+                .map(|&i| DVec3::from_array(m.positions[i as usize]))
+                .collect();
+            let n = penumbra::geom::plane::newell_normal(&poly);
+            let tn = (v[1] - v[0]).cross(v[2] - v[0]);
+            assert!(tn.dot(n) >= 0.0, "mesh {mi} triangle {t} is flipped");
+            got[bm.source_polygon[t] as usize] += tn.length() * 0.5;
+        }
+        for (pi, p) in m.polygons.iter().enumerate() {
+            let poly: Vec<DVec3> = p
+                .iter()
+                .map(|&i| DVec3::from_array(m.positions[i as usize]))
+                .collect();
+            let want = area3(&poly);
+            assert!(
+                (got[pi] - want).abs() <= 1e-9 * want.max(1e-300),
+                "mesh {mi} polygon {pi}: elements cover {} of {}",
+                got[pi],
+                want
+            );
+        }
+    }
+}
+
+/// A closed axis-aligned box (outward faces) as polygons.
+pub fn cuboid(lo: [f64; 3], hi: [f64; 3]) -> Vec<Vec<[f64; 3]>> {
+    let [x0, y0, z0] = lo;
+    let [x1, y1, z1] = hi;
+    vec![
+        vec![[x0, y0, z0], [x0, y1, z0], [x1, y1, z0], [x1, y0, z0]],
+        vec![[x0, y0, z1], [x1, y0, z1], [x1, y1, z1], [x0, y1, z1]],
+        vec![[x0, y0, z0], [x1, y0, z0], [x1, y0, z1], [x0, y0, z1]],
+        vec![[x1, y1, z0], [x0, y1, z0], [x0, y1, z1], [x1, y1, z1]],
+        vec![[x1, y0, z0], [x1, y1, z0], [x1, y1, z1], [x1, y0, z1]],
+        vec![[x0, y1, z0], [x0, y0, z0], [x0, y0, z1], [x0, y1, z1]],
+    ]
+}
