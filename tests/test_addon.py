@@ -414,3 +414,12 @@ def test_modal_timer_polls_until_the_bake_is_imported(room_scene, empty, monkeyp
     assert any(s and s.startswith("Penumbra: ") for s in ctx.workspace.status)
     assert len(bpy.data.collections[COLLECTION].objects) == len(ROOM_MESHES)
     assert "elements" in op.reports.items[-1][1]
+
+
+def test_overall_progress_follows_the_pipeline():
+    from penumbra.operators import overall_fraction
+
+    names = ["validate", "shadow volumes", "discontinuity loops", "meshing", "direct light", "indirect light"]
+    values = [overall_fraction(n, 0.5) for n in names]
+    assert values == sorted(values) and 0 < values[0] and values[-1] < 1
+    assert overall_fraction("something new", 0.5) == 0.0

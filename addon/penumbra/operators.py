@@ -13,8 +13,9 @@ from . import _core
 from .export import ExportError, export_scene
 from .import_ import import_bake
 
-# The core's stages in pipeline order, for one overall progress bar.
-STAGES = ("validate", "shadow", "edges", "arrangement", "loops", "relation", "mesh", "direct", "indirect", "output")
+# Words of the core's stage names ("shadow volumes", "discontinuity loops", "meshing", ...)
+# in pipeline order, for one overall progress bar.
+STAGES = ("validate", "shadow", "loop", "mesh", "direct", "indirect", "output")
 
 
 def prepare(context, report):
@@ -78,9 +79,14 @@ def has_ui(context):
 
 
 def overall_fraction(stage, fraction):
-    if stage not in STAGES:
-        return 0.0
-    return (STAGES.index(stage) + fraction) / len(STAGES)
+    """Progress of the whole bake in [0, 1]; 0 for a stage this add-on does not know."""
+    name = stage.lower()
+    # "indirect" contains "direct": look for it first.
+    keys = sorted(STAGES, key=lambda k: k != "indirect")
+    for key in keys:
+        if key in name:
+            return (STAGES.index(key) + fraction) / len(STAGES)
+    return 0.0
 
 
 class PENUMBRA_OT_bake(bpy.types.Operator):
@@ -109,6 +115,7 @@ class PENUMBRA_OT_bake(bpy.types.Operator):
             self.report({"ERROR"}, "Penumbra: %s" % e)
             return {"CANCELLED"}
         self._t0 = time.perf_counter()
+        self._shown = 0.0
         wm = context.window_manager
         self._timer = wm.event_timer_add(0.1, window=context.window)
         wm.progress_begin(0, 1000)
@@ -124,7 +131,9 @@ class PENUMBRA_OT_bake(bpy.types.Operator):
         if event.type != "TIMER":
             return {"PASS_THROUGH"}
         stage, fraction = self._job.progress()
-        context.window_manager.progress_update(int(1000 * overall_fraction(stage, fraction)))
+        # Never backwards, even past a stage this add-on does not know.
+        self._shown = max(self._shown, overall_fraction(stage, fraction))
+        context.window_manager.progress_update(int(1000 * self._shown))
         context.workspace.status_text_set(
             "Penumbra: %s %d%%  (Esc to cancel)" % (stage, int(round(100 * fraction)))
         )
