@@ -10,14 +10,22 @@ import numpy as np
 
 from .props import QUALITY_FRACTIONS
 
+_PACKAGE = __name__.rpartition(".")[0]
+
+# FALLBACK until branch `cycles` lands these two modules. Only their absence selects the
+# fallback: an import error inside them must surface, not be papered over.
 try:
     from .cycles_lights import lights_to_scene
-except ImportError:  # FALLBACK until cycles_lights.py lands (branch `cycles`)
+except ModuleNotFoundError as e:
+    if e.name != _PACKAGE + ".cycles_lights":
+        raise
     lights_to_scene = None
 
 try:
     from .materials import polygon_colors
-except ImportError:  # FALLBACK until materials.py lands (branch `cycles`)
+except ModuleNotFoundError as e:
+    if e.name != _PACKAGE + ".materials":
+        raise
     polygon_colors = None
 
 # Custom property of a baked object: the name of the object it was baked from.
