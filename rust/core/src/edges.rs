@@ -11,8 +11,9 @@ use crate::geom::polygon::{
     clip_polygon_2d, clip_polygon_3d, signed_area_2d, simplify_convex, HalfPlane,
 };
 use crate::geom::{Frame, Plane};
+use crate::scene::solids::Occluder;
 use crate::scene::{Face, LightKind, Scene};
-use crate::shadow::{shadow_volumes, ShadowVolumes, Volume};
+use crate::shadow::{shadow_volumes, solid_volumes, ShadowVolumes, SolidShadow, Volume};
 
 /// `occluder` value of the polygon that marks the part of a receiver behind an area light's
 /// plane (the light emits nothing there).
@@ -111,6 +112,52 @@ pub struct EdgeStats {
     pub t_isr: f64,
 }
 
+/// Shadow volumes of occluder `oi` under one light (a solid that cannot be treated whole
+/// falls back to its faces, all under the solid's index).
+fn occluder_volumes(
+    kind: &LightKind,
+    lv: Option<&[DVec3]>,
+    oi: u32,
+    occ: &Occluder,
+    faces: &[Face],
+    eps: f64,
+) -> Vec<ShadowVolumes> {
+    match occ {
+        Occluder::Face(f) => shadow_volumes(kind, lv, oi, &faces[*f as usize], eps)
+            .into_iter()
+            .collect(),
+        Occluder::Solid { faces: fs, solid } => match solid_volumes(kind, lv, oi, solid, eps) {
+            SolidShadow::Culled => Vec::new(),
+            SolidShadow::Volumes(v) => vec![v],
+            SolidShadow::Faces => fs
+                .iter()
+                .filter_map(|f| shadow_volumes(kind, lv, oi, &faces[*f as usize], eps))
+                .collect(),
+        },
+    }
+}
+
+/// Vertices and edges of an occluder (for culling against a receiver and finding contacts).
+fn occluder_outline(occ: &Occluder, faces: &[Face]) -> (Vec<DVec3>, Vec<[DVec3; 2]>) {
+    match occ {
+        Occluder::Face(f) => {
+            let v = &faces[*f as usize].verts;
+            (
+                v.clone(),
+                (0..v.len()).map(|i| [v[i], v[(i + 1) % v.len()]]).collect(),
+            )
+        }
+        Occluder::Solid { solid, .. } => (
+            solid.verts.clone(),
+            solid
+                .edges
+                .iter()
+                .map(|e| [solid.verts[e[0] as usize], solid.verts[e[1] as usize]])
+                .collect(),
+        ),
+    }
+}
+
 /// Shadow polygons on every receiver for every light.
 pub fn shadow_polygons(
     scene: &Scene,
@@ -118,7 +165,10 @@ pub fn shadow_polygons(
 ) -> Result<(Vec<ReceiverShadows>, EdgeStats), crate::BakeError> {
     let eps = 1e-12 * scene.diagonal().max(1e-300);
     let faces = &scene.faces;
+    let occs = &scene.occluders;
     let tree = BoxTree::new(faces.iter().map(|f| Aabb::from_points(&f.verts)).collect());
+    let outlines: Vec<(Vec<DVec3>, Vec<[DVec3; 2]>)> =
+        occs.iter().map(|o| occluder_outline(o, faces)).collect();
     let mut stats = EdgeStats::default();
     let mut per_receiver: Vec<ReceiverShadows> = (0..faces.len())
         .map(|i| ReceiverShadows {
@@ -133,32 +183,32 @@ pub fn shadow_polygons(
         progress.check()?;
         progress.set_fraction(li as f64 / scene.lights.len() as f64);
         let t0 = std::time::Instant::now();
-        let volumes: Vec<Option<ShadowVolumes>> = faces
+        let volumes: Vec<Vec<ShadowVolumes>> = occs
             .par_iter()
             .enumerate()
-            .map(|(oi, o)| shadow_volumes(&light.kind, None, oi as u32, o, eps))
+            .map(|(oi, o)| occluder_volumes(&light.kind, None, oi as u32, o, faces, eps))
             .collect();
-        stats.shadow_pairs += volumes.iter().filter(|v| v.is_some()).count() as u64;
-        stats.culled_pairs += volumes.iter().filter(|v| v.is_none()).count() as u64;
-        // Which receivers each volume can reach, inverted to receiver → volumes.
+        stats.shadow_pairs += volumes.iter().filter(|v| !v.is_empty()).count() as u64;
+        stats.culled_pairs += volumes.iter().filter(|v| v.is_empty()).count() as u64;
+        // Which receivers each volume can reach, inverted to receiver → occluders.
         let mut hits: Vec<Vec<u32>> = vec![Vec::new(); faces.len()];
         let found: Vec<Vec<u32>> = volumes
             .par_iter()
-            .map(|v| {
+            .map(|vs| {
                 let mut out = Vec::new();
-                if let Some(v) = v {
+                for v in vs {
                     for p in &v.penumbra {
                         tree.query_volume(&p.planes, eps, &mut out);
                     }
-                    out.sort_unstable();
-                    out.dedup();
                 }
+                out.sort_unstable();
+                out.dedup();
                 out
             })
             .collect();
         for (oi, rs) in found.iter().enumerate() {
             for &r in rs {
-                if r as usize != oi {
+                if scene.face_occluder[r as usize] as usize != oi {
                     hits[r as usize].push(oi as u32);
                 }
             }
@@ -173,9 +223,9 @@ pub fn shadow_polygons(
                 receiver_polygons(
                     li as u32,
                     &light.kind,
-                    ri,
                     r,
-                    faces,
+                    scene,
+                    &outlines,
                     &volumes,
                     &hits[ri],
                     eps,
@@ -200,10 +250,10 @@ pub fn shadow_polygons(
 fn receiver_polygons(
     li: u32,
     kind: &LightKind,
-    ri: usize,
     r: &Face,
-    faces: &[Face],
-    volumes: &[Option<ShadowVolumes>],
+    scene: &Scene,
+    outlines: &[(Vec<DVec3>, Vec<[DVec3; 2]>)],
+    volumes: &[Vec<ShadowVolumes>],
     hits: &[u32],
     eps: f64,
 ) -> (Exposure, Vec<ShadowPolygon>, Vec<[DVec2; 2]>) {
@@ -235,60 +285,55 @@ fn receiver_polygons(
         }
     }
     for &oi in hits {
-        let o = &faces[oi as usize];
+        let (verts, edges) = &outlines[oi as usize];
         // An occluder wholly on or behind the receiver's plane cannot come between it and
         // light arriving at its front.
-        if o.verts.iter().all(|v| r.plane.dist(*v) <= eps) {
+        if verts.iter().all(|v| r.plane.dist(*v) <= eps) {
             continue;
         }
-        for i in 0..o.verts.len() {
-            let (a, b) = (o.verts[i], o.verts[(i + 1) % o.verts.len()]);
-            if r.plane.dist(a).abs() <= touch && r.plane.dist(b).abs() <= touch {
-                contacts.push([r.frame.to_2d(a), r.frame.to_2d(b)]);
+        for [a, b] in edges {
+            if r.plane.dist(*a).abs() <= touch && r.plane.dist(*b).abs() <= touch {
+                contacts.push([r.frame.to_2d(*a), r.frame.to_2d(*b)]);
             }
         }
         let recomputed;
-        let sv = match &clipped_light {
-            None => match &volumes[oi as usize] {
-                Some(v) => v,
-                None => continue,
-            },
+        let svs: &[ShadowVolumes] = match &clipped_light {
+            None => &volumes[oi as usize],
             Some(lv) => {
-                recomputed = shadow_volumes(kind, Some(lv), oi, o, eps);
-                match &recomputed {
-                    Some(v) => v,
-                    None => continue,
-                }
+                recomputed = occluder_volumes(
+                    kind,
+                    Some(lv),
+                    oi,
+                    &scene.occluders[oi as usize],
+                    &scene.faces,
+                    eps,
+                );
+                &recomputed
             }
         };
-        let _ = ri;
-        for p in &sv.penumbra {
-            if let Some(poly) = clip_to_volume(r, p, eps) {
-                out.push(ShadowPolygon {
-                    light: li,
-                    occluder: oi,
-                    umbra: false,
-                    hard: sv.hard,
-                    poly,
-                });
-            }
-        }
-        if let Some(u) = &sv.umbra {
-            if sv.hard {
-                // Point/sun: the same polygon is both; mark the one already pushed.
-                if let Some(last) = out.last_mut() {
-                    if last.occluder == oi {
-                        last.umbra = true;
-                    }
+        for sv in svs {
+            for p in &sv.penumbra {
+                if let Some(poly) = clip_to_volume(r, p, eps) {
+                    // Point/sun: the one volume is umbra and penumbra at once.
+                    out.push(ShadowPolygon {
+                        light: li,
+                        occluder: oi,
+                        umbra: sv.hard,
+                        hard: sv.hard,
+                        poly,
+                    });
                 }
-            } else if let Some(poly) = clip_to_volume(r, u, eps) {
-                out.push(ShadowPolygon {
-                    light: li,
-                    occluder: oi,
-                    umbra: true,
-                    hard: false,
-                    poly,
-                });
+            }
+            if let (Some(u), false) = (&sv.umbra, sv.hard) {
+                if let Some(poly) = clip_to_volume(r, u, eps) {
+                    out.push(ShadowPolygon {
+                        light: li,
+                        occluder: oi,
+                        umbra: true,
+                        hard: false,
+                        poly,
+                    });
+                }
             }
         }
     }

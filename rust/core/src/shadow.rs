@@ -18,6 +18,7 @@ use robust::{orient3d, Coord3D};
 use crate::geom::plane::newell_normal;
 use crate::geom::polygon::clip_polygon_3d;
 use crate::geom::Plane;
+use crate::scene::solids::Solid;
 use crate::scene::{Face, LightKind};
 
 /// Closed convex volume: the points with `plane.dist(p) >= 0` for every plane.
@@ -71,49 +72,45 @@ fn side(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
     orient3d(c3(a), c3(b), c3(c), c3(d))
 }
 
-/// Separating planes through an edge of `p` and a vertex of `q` (exact side tests): all of
-/// `p` on one closed side, all of `q` on the other. Each is oriented towards `o_side`'s
-/// polygon (`true` → towards q, else towards p).
-fn separating_planes(p: &[DVec3], q: &[DVec3], towards_q: bool, out: &mut Vec<Plane>) {
-    let cq = q.iter().copied().sum::<DVec3>() / q.len() as f64;
-    let cp = p.iter().copied().sum::<DVec3>() / p.len() as f64;
-    for i in 0..p.len() {
-        let a = p[i];
-        let b = p[(i + 1) % p.len()];
-        for &v in q {
-            // Sign of each polygon's vertices relative to plane (a, b, v).
-            let mut sp = 0i8;
-            let mut ok = true;
-            for &x in p {
-                let s = side(a, b, v, x);
-                if s != 0.0 {
-                    let sg = if s > 0.0 { 1 } else { -1 };
-                    if sp == 0 {
-                        sp = sg;
-                    } else if sp != sg {
-                        ok = false;
-                        break;
-                    }
+/// Separating planes through an edge of `p` (given as vertex index pairs) and a vertex of
+/// `q` (exact side tests): all of `p` on one closed side, all of `q` strictly on the other.
+/// Each is oriented towards q's side (`towards_q`) or p's side.
+fn separating_planes(
+    pv: &[DVec3],
+    pe: &[[u32; 2]],
+    qv: &[DVec3],
+    towards_q: bool,
+    out: &mut Vec<Plane>,
+) {
+    let cq = qv.iter().copied().sum::<DVec3>() / qv.len() as f64;
+    let cp = pv.iter().copied().sum::<DVec3>() / pv.len() as f64;
+    let one_side = |a: DVec3, b: DVec3, v: DVec3, pts: &[DVec3]| -> Option<i8> {
+        let mut sg = 0i8;
+        for &x in pts {
+            let s = side(a, b, v, x);
+            if s != 0.0 {
+                let t = if s > 0.0 { 1 } else { -1 };
+                if sg == 0 {
+                    sg = t;
+                } else if sg != t {
+                    return None;
                 }
             }
-            if !ok {
+        }
+        Some(sg)
+    };
+    for &[i, j] in pe {
+        let (a, b) = (pv[i as usize], pv[j as usize]);
+        for &v in qv {
+            // Test q first: for a solid it has the most points and fails soonest.
+            let Some(sq) = one_side(a, b, v, qv) else {
                 continue;
-            }
-            let mut sq = 0i8;
-            for &x in q {
-                let s = side(a, b, v, x);
-                if s != 0.0 {
-                    let sg = if s > 0.0 { 1 } else { -1 };
-                    if sq == 0 {
-                        sq = sg;
-                    } else if sq != sg {
-                        ok = false;
-                        break;
-                    }
-                }
-            }
+            };
+            let Some(sp) = one_side(a, b, v, pv) else {
+                continue;
+            };
             // Separating: strictly opposite sides (a polygon wholly in the plane is degenerate).
-            if !ok || sp == 0 || sq == 0 || sp == sq {
+            if sp == 0 || sq == 0 || sp == sq {
                 continue;
             }
             let target = if towards_q { cq } else { cp };
@@ -128,11 +125,15 @@ fn separating_planes(p: &[DVec3], q: &[DVec3], towards_q: bool, out: &mut Vec<Pl
     }
 }
 
+fn ring(n: usize) -> Vec<[u32; 2]> {
+    (0..n as u32).map(|i| [i, (i + 1) % n as u32]).collect()
+}
+
 /// The penumbra volume of light piece `l` (strictly on one side of `o`'s plane) and occluder `o`.
 fn penumbra_volume(l: &[DVec3], o: &[DVec3]) -> Volume {
     let mut planes = Vec::new();
-    separating_planes(l, o, true, &mut planes);
-    separating_planes(o, l, false, &mut planes);
+    separating_planes(l, &ring(l.len()), o, true, &mut planes);
+    separating_planes(o, &ring(o.len()), l, false, &mut planes);
     // The polygons' own planes, when they separate.
     for (poly, other, towards_o) in [(l, o, true), (o, l, false)] {
         let Some(pl) = Plane::from_polygon(poly) else {
@@ -292,6 +293,143 @@ pub fn shadow_volumes(
             })
         }
     }
+}
+
+/// What a convex solid does under one light.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SolidShadow {
+    /// It cannot shadow anything (behind the light).
+    Culled,
+    /// It touches or crosses the light's plane (or contains a point light): treat its faces
+    /// one by one instead.
+    Faces,
+    Volumes(ShadowVolumes),
+}
+
+/// Shadow volumes of a closed convex solid (occluder index `oi`).
+pub fn solid_volumes(
+    kind: &LightKind,
+    light_verts_override: Option<&[DVec3]>,
+    oi: u32,
+    s: &Solid,
+    eps: f64,
+) -> SolidShadow {
+    match kind {
+        LightKind::Area { verts, plane, .. } => {
+            let lv = light_verts_override.unwrap_or(verts);
+            let d: Vec<f64> = s.verts.iter().map(|v| plane.dist(*v)).collect();
+            if d.iter().all(|&x| x <= eps) {
+                return SolidShadow::Culled;
+            }
+            if d.iter().any(|&x| x <= eps) {
+                return SolidShadow::Faces;
+            }
+            // Penumbra: separating planes (light edge + solid vertex, solid edge + light
+            // vertex), the light's plane, and the solid's faces that have the whole light in
+            // front of them.
+            let mut planes = Vec::new();
+            separating_planes(lv, &ring(lv.len()), &s.verts, true, &mut planes);
+            let sil: Vec<[u32; 2]> = s
+                .edges
+                .iter()
+                .zip(&s.edge_planes)
+                .filter(|(_, fp)| {
+                    lv.iter().any(|l| {
+                        (s.planes[fp[0] as usize].dist(*l) > 0.0)
+                            != (s.planes[fp[1] as usize].dist(*l) > 0.0)
+                    })
+                })
+                .map(|(e, _)| *e)
+                .collect();
+            separating_planes(&s.verts, &sil, lv, false, &mut planes);
+            planes.push(*plane);
+            for f in &s.planes {
+                if lv.iter().all(|l| f.dist(*l) >= -eps) {
+                    planes.push(f.flipped());
+                }
+            }
+            let penumbra = Volume { planes };
+            let mut umbra_planes = vec![*plane];
+            for &l in lv {
+                match point_solid_volume(l, s, eps) {
+                    Some(v) => umbra_planes.extend(v.planes),
+                    None => return SolidShadow::Faces,
+                }
+            }
+            SolidShadow::Volumes(ShadowVolumes {
+                occluder: oi,
+                penumbra: vec![penumbra],
+                umbra: Some(Volume {
+                    planes: umbra_planes,
+                }),
+                hard: false,
+            })
+        }
+        LightKind::Point { position, .. } => match point_solid_volume(*position, s, eps) {
+            Some(v) => SolidShadow::Volumes(ShadowVolumes {
+                occluder: oi,
+                penumbra: vec![v.clone()],
+                umbra: Some(v),
+                hard: true,
+            }),
+            None => SolidShadow::Faces,
+        },
+        LightKind::Sun { direction, .. } => {
+            let front: Vec<bool> = s
+                .planes
+                .iter()
+                .map(|p| p.n.dot(*direction) < -1e-12)
+                .collect();
+            let mut planes = Vec::new();
+            for (e, fp) in s.edges.iter().zip(&s.edge_planes) {
+                if front[fp[0] as usize] != front[fp[1] as usize] {
+                    let (a, b) = (s.verts[e[0] as usize], s.verts[e[1] as usize]);
+                    match oriented_plane(a, b, a + *direction * (b - a).length(), s.centroid) {
+                        Some(p) => planes.push(p),
+                        None => return SolidShadow::Faces,
+                    }
+                }
+            }
+            for (f, is_front) in s.planes.iter().zip(&front) {
+                if *is_front {
+                    planes.push(f.flipped());
+                }
+            }
+            let v = Volume { planes };
+            SolidShadow::Volumes(ShadowVolumes {
+                occluder: oi,
+                penumbra: vec![v.clone()],
+                umbra: Some(v),
+                hard: true,
+            })
+        }
+    }
+}
+
+/// Shadow volume of a convex solid from a point: the cone through its silhouette, beyond the
+/// faces that face the point. `None` when the point is inside or on the solid.
+fn point_solid_volume(l: DVec3, s: &Solid, eps: f64) -> Option<Volume> {
+    let front: Vec<bool> = s.planes.iter().map(|p| p.dist(l) > eps).collect();
+    if !front.iter().any(|&f| f) {
+        return None;
+    }
+    let mut planes = Vec::new();
+    for (e, fp) in s.edges.iter().zip(&s.edge_planes) {
+        if front[fp[0] as usize] != front[fp[1] as usize] {
+            planes.push(oriented_plane(
+                l,
+                s.verts[e[0] as usize],
+                s.verts[e[1] as usize],
+                s.centroid,
+            )?);
+        }
+    }
+    for (f, is_front) in s.planes.iter().zip(&front) {
+        if *is_front {
+            planes.push(f.flipped());
+        }
+    }
+    Some(Volume { planes })
 }
 
 #[cfg(test)]

@@ -12,7 +12,7 @@ fn random_poly(rng: &mut Rng, c: DVec3, size: f64, n: usize, normal: DVec3) -> V
     (0..n)
         .map(|k| {
             let a = phase + k as f64 * std::f64::consts::TAU / n as f64 + rng.range(-0.2, 0.2);
-            let r = size * rng.range(0.6, 1.0);
+            let r = size; // on a circle, in angular order: convex
             f.to_3d(glam::DVec2::new(a.cos() * r, a.sin() * r))
                 .to_array()
         })
@@ -48,6 +48,30 @@ fn random_scene(seed: u64) -> penumbra::SceneJson {
             &format!("Occ{k}"),
             vec![random_poly(&mut rng, c, size, n, tilt)],
         ));
+    }
+    if rng.next() < 0.5 {
+        let (x, y, z) = (
+            rng.range(-1.0, 1.0),
+            rng.range(-1.0, 1.0),
+            rng.range(0.0, 0.8),
+        );
+        let (w, d, h) = (
+            rng.range(0.1, 0.4),
+            rng.range(0.1, 0.4),
+            rng.range(0.1, 0.5),
+        );
+        meshes.push(mesh(
+            "Box",
+            cuboid([x - w, y - d, z], [x + w, y + d, z + h]),
+        ));
+    }
+    if rng.next() < 0.4 {
+        let c = [
+            rng.range(-1.0, 1.0),
+            rng.range(-1.0, 1.0),
+            rng.range(0.5, 1.2),
+        ];
+        meshes.push(mesh("Ball", uv_sphere(c, rng.range(0.15, 0.4), 10, 6)));
     }
     let mut lights = Vec::new();
     let n_lights = 1 + (rng.next() * 2.0) as usize;
@@ -102,4 +126,15 @@ fn relations_match_exact_visibility_on_random_scenes() {
         checked[1] > 100 && checked[2] > 100 && checked[3] > 100,
         "{checked:?}"
     );
+}
+
+#[test]
+#[ignore]
+fn dump_seed() {
+    let seed: u64 = std::env::var("SEED").unwrap().parse().unwrap();
+    std::fs::write(
+        "/tmp/sc/seed.json",
+        serde_json::to_string_pretty(&random_scene(seed)).unwrap(),
+    )
+    .unwrap();
 }

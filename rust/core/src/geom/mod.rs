@@ -4,6 +4,7 @@
 
 pub mod bvh;
 pub mod frame;
+pub mod lambert;
 pub mod plane;
 pub mod polygon;
 

@@ -3,6 +3,7 @@
 
 pub mod convex;
 pub mod json;
+pub mod solids;
 pub mod validate;
 
 use glam::{DVec2, DVec3};
@@ -78,6 +79,10 @@ pub struct Light {
 pub struct Scene {
     pub meshes: Vec<MeshInfo>,
     pub faces: Vec<Face>,
+    /// What casts shadows: single faces, and closed convex components as solids.
+    pub occluders: Vec<solids::Occluder>,
+    /// The occluder each face belongs to.
+    pub face_occluder: Vec<u32>,
     pub lights: Vec<Light>,
     pub settings: Settings,
     pub bounds_min: DVec3,

@@ -6,6 +6,7 @@ use glam::DVec3;
 
 use super::convex::convex_pieces;
 use super::json::{LightJson, MeshJson, PerPolygon, SceneJson};
+use super::solids::{find_solids, Occluder};
 use super::{Face, Light, LightKind, MeshInfo, Scene, Spot};
 use crate::geom::{Frame, Plane};
 use crate::settings::Settings;
@@ -20,6 +21,7 @@ pub fn validate(s: &SceneJson) -> Result<Scene, BakeError> {
     let mut warnings = Vec::new();
     let mut meshes = Vec::with_capacity(s.meshes.len());
     let mut faces = Vec::new();
+    let mut occluders = Vec::new();
     let mut lo = DVec3::splat(f64::INFINITY);
     let mut hi = DVec3::splat(f64::NEG_INFINITY);
 
@@ -35,6 +37,7 @@ pub fn validate(s: &SceneJson) -> Result<Scene, BakeError> {
         let obj = format!("mesh {:?} (meshes[{mi}])", m.name);
         let start = faces.len();
         validate_mesh(mi, m, &obj, &mut faces, &mut warnings, &mut lo, &mut hi)?;
+        occluders.extend(find_solids(m, &faces, start));
         meshes.push(MeshInfo {
             name: m.name.clone(),
             n_polygons: m.polygons.len(),
@@ -46,6 +49,18 @@ pub fn validate(s: &SceneJson) -> Result<Scene, BakeError> {
         return Err(BakeError::Empty(
             "every polygon of every mesh is degenerate (no area)".into(),
         ));
+    }
+    let mut face_occluder = vec![u32::MAX; faces.len()];
+    for (oi, o) in occluders.iter().enumerate() {
+        for &f in o.faces() {
+            face_occluder[f as usize] = oi as u32;
+        }
+    }
+    for (fi, fo) in face_occluder.iter_mut().enumerate() {
+        if *fo == u32::MAX {
+            *fo = occluders.len() as u32;
+            occluders.push(Occluder::Face(fi as u32));
+        }
     }
     let mut lights = Vec::with_capacity(s.lights.len());
     for (li, l) in s.lights.iter().enumerate() {
@@ -82,6 +97,8 @@ pub fn validate(s: &SceneJson) -> Result<Scene, BakeError> {
     Ok(Scene {
         meshes,
         faces,
+        occluders,
+        face_occluder,
         lights,
         settings,
         bounds_min: lo,
