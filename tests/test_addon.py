@@ -423,3 +423,9 @@ def test_overall_progress_follows_the_pipeline():
     values = [overall_fraction(n, 0.5) for n in names]
     assert values == sorted(values) and 0 < values[0] and values[-1] < 1
     assert overall_fraction("something new", 0.5) == 0.0
+
+
+def test_a_light_the_scene_json_cannot_hold_is_refused(room_scene, empty):
+    _, light = room_scene
+    light.data.use_shadow = False
+    _refused(empty, ["Ceiling Light", "use_shadow"])

@@ -3,30 +3,13 @@ modifiers, in world space, and the lights in scene-JSON form. Only numpy and
 ``foreach_get`` touch mesh data; nothing here changes the Blender scene.
 """
 
-import math
-
 import bpy
 import numpy as np
 
 from .props import QUALITY_FRACTIONS
 
-_PACKAGE = __name__.rpartition(".")[0]
-
-# FALLBACK until branch `cycles` lands these two modules. Only their absence selects the
-# fallback: an import error inside them must surface, not be papered over.
-try:
-    from .cycles_lights import lights_to_scene
-except ModuleNotFoundError as e:
-    if e.name != _PACKAGE + ".cycles_lights":
-        raise
-    lights_to_scene = None
-
-try:
-    from .materials import polygon_colors
-except ModuleNotFoundError as e:
-    if e.name != _PACKAGE + ".materials":
-        raise
-    polygon_colors = None
+from .cycles_lights import lights_to_scene
+from .materials import polygon_colors
 
 # Custom property of a baked object: the name of the object it was baked from.
 SOURCE_KEY = "penumbra_source"
@@ -42,10 +25,12 @@ class ExportError(Exception):
 class Export:
     """What a bake needs: the scene for the core and the source objects, in mesh order."""
 
-    def __init__(self, scene, sources, lights):
+    def __init__(self, scene, sources, lights, warnings):
         self.scene = scene
         self.sources = sources
         self.lights = lights
+        # Material features approximated on the way out (from materials.polygon_colors).
+        self.warnings = warnings
 
 
 def export_scene(context, settings, objects=None):
@@ -68,7 +53,8 @@ def export_scene(context, settings, objects=None):
         ]
     depsgraph = context.evaluated_depsgraph_get()
 
-    meshes = [_mesh(o, depsgraph) for o in sources]
+    warnings = []
+    meshes = [_mesh(o, depsgraph, warnings) for o in sources]
     light_dicts = []
     for o in lights:
         light_dicts.extend(_light(o, depsgraph))
@@ -77,7 +63,7 @@ def export_scene(context, settings, objects=None):
         raise ExportError("No lights: add a light or select one (or give a material emission)")
 
     scene = {"meshes": meshes, "lights": light_dicts, "settings": _settings(settings, meshes, light_dicts)}
-    return Export(scene, sources, lights)
+    return Export(scene, sources, lights, warnings)
 
 
 def _sources(objects):
@@ -97,7 +83,7 @@ def _sources(objects):
     return out
 
 
-def _mesh(obj, depsgraph):
+def _mesh(obj, depsgraph, warnings):
     obj_eval = obj.evaluated_get(depsgraph)
     mesh = obj_eval.to_mesh()
     try:
@@ -124,10 +110,7 @@ def _mesh(obj, depsgraph):
         mesh.loops.foreach_get("vertex_index", loop_vert)
         polygon_vertices = loop_vert[_loop_order(starts, counts, np.linalg.det(m[:3, :3]) < 0.0)]
 
-        if polygon_colors is not None:
-            albedo, emission = polygon_colors(obj_eval, mesh)
-        else:
-            albedo, emission = _fallback_polygon_colors(obj_eval, mesh)
+        albedo, emission = polygon_colors(obj_eval, mesh, warnings)
         return {
             "name": obj.name,
             "positions": positions,
@@ -163,10 +146,10 @@ def _light(obj, depsgraph):
         scale = obj.matrix_world.to_scale()
         if abs(scale.x * scale.y) <= 0.0:
             raise ExportError('Light "%s": scale: the area light is scaled to zero size' % obj.name)
-    if lights_to_scene is not None:
+    try:
         dicts = lights_to_scene(obj, depsgraph)
-    else:
-        dicts = _fallback_lights_to_scene(obj)
+    except ValueError as e:  # a light feature the scene JSON cannot hold; names light and field
+        raise ExportError(str(e))
     for d in dicts:
         polygon = d.get("polygon")
         if polygon is not None and _polygon_area(np.asarray(polygon, dtype=np.float64)) <= 0.0:
@@ -200,72 +183,3 @@ def _settings(settings, meshes, lights):
         "convergence": float(settings.convergence),
         "lighting_only": bool(settings.lighting_only),
     }
-
-
-# --- FALLBACK until branch `cycles` lands cycles_lights.py and materials.py --------------
-# Minimal stand-ins so that export works and can be tested before then; the real modules
-# match Cycles' units and shaders, these only cover the plain cases.
-
-
-def _fallback_lights_to_scene(obj):
-    light = obj.data
-    m = obj.matrix_world
-    color = [float(c) for c in light.color]
-    power = float(light.energy)
-    if light.type == "AREA":
-        sx = light.size
-        sy = light.size_y if light.shape in {"RECTANGLE", "ELLIPSE"} else light.size
-        if light.shape in {"DISK", "ELLIPSE"}:
-            n = 16
-            local = [(0.5 * sx * math.cos(2 * math.pi * k / n), 0.5 * sy * math.sin(2 * math.pi * k / n)) for k in range(n)]
-        else:
-            local = [(-0.5 * sx, -0.5 * sy), (0.5 * sx, -0.5 * sy), (0.5 * sx, 0.5 * sy), (-0.5 * sx, 0.5 * sy)]
-        # Blender's area light shines along its local -Z: counter-clockwise seen from -Z.
-        world = [m @ _vec(x, y, 0.0) for (x, y) in reversed(local)]
-        area = _polygon_area(np.array([list(v) for v in world]))
-        radiance = power / (math.pi * area) if area > 0 else 0.0
-        return [{"name": obj.name, "polygon": [list(v) for v in world], "radiance": [radiance * c for c in color]}]
-    if light.type in {"POINT", "SPOT"}:
-        d = {"name": obj.name, "point": list(m.translation), "intensity": [power / (4 * math.pi) * c for c in color]}
-        if light.type == "SPOT":
-            axis = (m.to_3x3() @ _vec(0.0, 0.0, -1.0)).normalized()
-            d["spot"] = {"direction": list(axis), "angle": float(light.spot_size), "blend": float(light.spot_blend)}
-        return [d]
-    if light.type == "SUN":
-        axis = (m.to_3x3() @ _vec(0.0, 0.0, -1.0)).normalized()
-        return [{"name": obj.name, "direction": list(axis), "irradiance": [power * c for c in color]}]
-    return []
-
-
-def _vec(x, y, z):
-    from mathutils import Vector
-
-    return Vector((x, y, z))
-
-
-def _fallback_polygon_colors(obj_eval, mesh):
-    n = len(mesh.polygons)
-    slots = []
-    for slot in obj_eval.material_slots:
-        albedo, emission = (0.8, 0.8, 0.8), (0.0, 0.0, 0.0)
-        mat = slot.material
-        if mat is not None:
-            albedo = tuple(mat.diffuse_color[:3])
-            tree = mat.node_tree
-            bsdf = tree and next((nd for nd in tree.nodes if nd.type == "BSDF_PRINCIPLED"), None)
-            if bsdf:
-                albedo = tuple(bsdf.inputs["Base Color"].default_value[:3])
-                ec = bsdf.inputs.get("Emission Color") or bsdf.inputs.get("Emission")
-                es = bsdf.inputs.get("Emission Strength")
-                if ec is not None:
-                    s = es.default_value if es is not None else 1.0
-                    emission = tuple(s * c for c in ec.default_value[:3])
-        slots.append((albedo, emission))
-    if not slots:
-        return np.full((n, 3), 0.8), np.zeros((n, 3))
-    index = np.empty(n, dtype=np.int64)
-    mesh.polygons.foreach_get("material_index", index)
-    index = np.clip(index, 0, len(slots) - 1)
-    table_a = np.array([s[0] for s in slots], dtype=np.float64)
-    table_e = np.array([s[1] for s in slots], dtype=np.float64)
-    return table_a[index], table_e[index]

@@ -49,9 +49,10 @@ def finish(context, export, result, seconds, report):
         vertices,
         seconds,
     )
-    if result["warnings"]:
-        summary += " (%d warning%s, see console)" % (len(result["warnings"]), "" if len(result["warnings"]) == 1 else "s")
-        for w in result["warnings"]:
+    warnings = list(export.warnings) + list(result["warnings"])
+    if warnings:
+        summary += " (%d warning%s, see console)" % (len(warnings), "" if len(warnings) == 1 else "s")
+        for w in warnings:
             print("Penumbra warning:", w)
     settings.last_summary = summary
     settings.last_stats = json.dumps(dict(stats, seconds=seconds))
