@@ -3,6 +3,7 @@ whose Python is the system's) and with the bpy module."""
 
 import json
 import os
+import struct
 import subprocess
 import sys
 
@@ -103,10 +104,16 @@ def test_bpy_module_bakes_all_visible_meshes(tmp_path):
     room.select_only(bpy.context.view_layer, [])
     scene = str(tmp_path / "scene5.blend")
     bpy.ops.wm.save_as_mainfile(filepath=scene, copy=True)
-    out = tmp_path / "sub" / "baked.blend"
-    r = run([sys.executable, BAKE, scene, "--output", str(out), "--all", "--quality", "draft", "--hide-originals"])
+    out, glb = tmp_path / "sub" / "baked.blend", tmp_path / "baked.glb"
+    r = run([sys.executable, BAKE, scene, "--output", str(out), "--all", "--quality", "draft", "--hide-originals", "--gltf", str(glb)])
     assert r.returncode == 0, r.stdout + r.stderr
     assert report(out)["baked"] == ROOM_BAKED
+    # The .glb carries the baked colours as vertex colours.
+    data = glb.read_bytes()
+    n = struct.unpack("<I", data[12:16])[0]
+    gltf = json.loads(data[20 : 20 + n])
+    assert sorted(m["name"] for m in gltf["meshes"]) == ROOM_BAKED
+    assert all("COLOR_0" in p["attributes"] for m in gltf["meshes"] for p in m["primitives"])
 
 
 def test_bpy_module_reports_a_missing_file(tmp_path):
