@@ -73,6 +73,10 @@ pub fn uv_sphere(c: P, r: f64, seg: usize, rings: usize) -> Vec<Vec<P>> {
     let pt = |i: usize, j: usize| -> P {
         let th = PI * j as f64 / rings as f64;
         let ph = TAU * (i % seg) as f64 / seg as f64;
+        // One vertex per pole, as Blender makes it (sin π is not exactly 0).
+        if j == 0 || j == rings {
+            return [c[0], c[1], c[2] + if j == 0 { r } else { -r }];
+        }
         [
             c[0] + r * th.sin() * ph.cos(),
             c[1] + r * th.sin() * ph.sin(),

@@ -3,6 +3,10 @@
 use std::sync::atomic::AtomicU64;
 use std::time::Instant;
 
+use std::collections::HashMap;
+use std::f64::consts::PI;
+
+use glam::DVec3;
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -10,6 +14,7 @@ use crate::edges;
 use crate::elements::{Elements, Region};
 use crate::mesh::{self, ReceiverMesh};
 use crate::regions::{self, ReceiverRegions, RegionTimes};
+use crate::vertex_light;
 
 use crate::progress::Progress;
 use crate::scene::json::SceneJson;
@@ -63,7 +68,7 @@ pub struct BakedMesh {
     pub positions: Vec<[f64; 3]>,
     pub triangles: Vec<[u32; 3]>,
     /// Linear RGB outgoing radiance per vertex.
-    pub colors: Vec<[f32; 3]>,
+    pub colors: Vec<[f64; 3]>,
     /// Per triangle: index of the input polygon it lies in.
     pub source_polygon: Vec<u32>,
     /// Per triangle: one relation code per light (1 lit, 2 penumbra, 3 umbra), in the order
@@ -127,7 +132,7 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
         .faces
         .par_iter()
         .zip(&shadows)
-        .map(|(f, sh)| regions::build_regions(f, sh, diag))
+        .map(|(f, sh)| regions::build_regions(f, sh, diag, scene.settings.uniform))
         .collect();
     // Stage times are wall time, split between sub-stages by their share of CPU time.
     let wall = t.elapsed().as_secs_f64();
@@ -165,7 +170,13 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
     stats.N_e = elements.triangles.len() as u64;
     stats.N_v = elements.positions.len() as u64;
 
-    let radiance = vec![[0.0f32; 3]; elements.positions.len()];
+    progress.stage("direct light");
+    let t = Instant::now();
+    let (direct, pairs) = vertex_light::direct_irradiance(scene, &elements, progress)?;
+    stats.T_direct = t.elapsed().as_secs_f64();
+    [stats.pairs_umbra, stats.pairs_lit, stats.pairs_penumbra] = pairs;
+
+    let radiance = colors(scene, &elements, &direct);
     let out = output(scene, &elements, &radiance);
     stats.T_total = t_start.elapsed().as_secs_f64();
     Ok(Bake {
@@ -204,8 +215,64 @@ fn assemble(scene: &Scene, meshes: &[ReceiverMesh]) -> Elements {
     el
 }
 
+/// Outgoing radiance of a Lambertian surface, `albedo · E / π + emission` (what Cycles'
+/// Diffuse bake with direct, indirect and colour gives), or `E / π` for lighting only.
+fn colors(scene: &Scene, el: &Elements, irradiance: &[DVec3]) -> Vec<[f64; 3]> {
+    irradiance
+        .iter()
+        .zip(&el.vertex_face)
+        .map(|(e, &f)| {
+            let face = &scene.faces[f as usize];
+            let c = if scene.settings.lighting_only {
+                *e / PI
+            } else {
+                face.albedo * *e / PI + face.emission
+            };
+            c.to_array()
+        })
+        .collect()
+}
+
+/// Which vertex stands for each vertex in the output: vertices of different faces of one
+/// mesh that coincide, face the same way and carry the same colour become one, so that a
+/// polygon split into convex pieces, or a flat floor of many quads, comes out as one
+/// connected surface. D0 rows keep their two vertices (their colours differ), and so do
+/// creases (their normals differ).
+fn weld(scene: &Scene, el: &Elements, colors: &[[f64; 3]]) -> Vec<u32> {
+    let q = 1e-9 * scene.diagonal().max(1e-300);
+    let cmax = colors
+        .iter()
+        .flat_map(|c| c.iter())
+        .fold(0.0f64, |a, &b| a.max(b.abs()));
+    let mut buckets: HashMap<(u32, [i64; 3]), Vec<u32>> = HashMap::new();
+    let mut canon: Vec<u32> = (0..el.positions.len() as u32).collect();
+    for v in 0..el.positions.len() {
+        let face = el.vertex_face[v] as usize;
+        let key = (
+            scene.faces[face].mesh,
+            el.positions[v].to_array().map(|x| (x / q).round() as i64),
+        );
+        let list = buckets.entry(key).or_default();
+        let c = colors[v];
+        let same = list.iter().copied().find(|&w| {
+            let w = w as usize;
+            el.vertex_face[w] as usize != face
+                && el.normals[w].dot(el.normals[v]) > 1.0 - 1e-9
+                && (0..3).all(|k| {
+                    (colors[w][k] - c[k]).abs()
+                        <= 1e-6 * c[k].abs().max(colors[w][k].abs()) + 1e-12 * cmax
+                })
+        });
+        match same {
+            Some(w) => canon[v] = w,
+            None => list.push(v as u32),
+        }
+    }
+    canon
+}
+
 /// Splits the scene-wide elements back into one mesh per input mesh.
-fn output(scene: &Scene, el: &Elements, colors: &[[f32; 3]]) -> Vec<BakedMesh> {
+fn output(scene: &Scene, el: &Elements, colors: &[[f64; 3]]) -> Vec<BakedMesh> {
     let mut out: Vec<BakedMesh> = scene
         .meshes
         .iter()
@@ -214,12 +281,19 @@ fn output(scene: &Scene, el: &Elements, colors: &[[f32; 3]]) -> Vec<BakedMesh> {
             ..BakedMesh::default()
         })
         .collect();
+    let canon = weld(scene, el, colors);
     let mut remap = vec![u32::MAX; el.positions.len()];
     for (t, tri) in el.triangles.iter().enumerate() {
         let f = &scene.faces[el.tri_face[t] as usize];
         let m = &mut out[f.mesh as usize];
         let mut idx = [0u32; 3];
-        for (k, &v) in tri.iter().enumerate() {
+        for (k, &v) in tri
+            .iter()
+            .map(|&v| canon[v as usize])
+            .collect::<Vec<_>>()
+            .iter()
+            .enumerate()
+        {
             if remap[v as usize] == u32::MAX {
                 remap[v as usize] = m.positions.len() as u32;
                 m.positions.push(el.positions[v as usize].to_array());

@@ -70,7 +70,7 @@ pub fn mesh_receiver(
     let coarse = settings.element_size;
     let mut seeds = Vec::new();
     for (f, rf) in arr.faces.iter().zip(&rr.faces) {
-        let h = if rf.relations.iter().any(|r| *r == Relation::Penumbra) {
+        let h = if !settings.uniform && rf.relations.iter().any(|r| *r == Relation::Penumbra) {
             fine
         } else {
             coarse
@@ -106,7 +106,15 @@ pub fn mesh_receiver(
         cdt.num_vertices() as u64 - handle.len() as u64,
         Ordering::Relaxed,
     );
-    Ok(extract(&cdt, sh))
+    if settings.uniform {
+        let mut m = extract(&cdt, sh, true);
+        m.regions = vec![rr.faces.first().cloned().unwrap_or(RegionFace {
+            relations: Vec::new(),
+            blockers: Vec::new(),
+        })];
+        return Ok(m);
+    }
+    Ok(extract(&cdt, sh, false))
 }
 
 /// Triangular lattice points strictly inside `f`, at least 0.35·h from its boundary.
@@ -185,7 +193,7 @@ fn seg_dist(a: DVec2, b: DVec2, p: DVec2) -> f64 {
 
 /// Triangles, their regions (connected components across non-constraint edges, classified
 /// once each), and the D0 vertex split.
-fn extract(cdt: &Cdt, sh: &ReceiverShadows) -> ReceiverMesh {
+fn extract(cdt: &Cdt, sh: &ReceiverShadows, uniform: bool) -> ReceiverMesh {
     let nv = cdt.num_vertices();
     let mut positions: Vec<DVec2> = cdt
         .vertices()
@@ -203,6 +211,16 @@ fn extract(cdt: &Cdt, sh: &ReceiverShadows) -> ReceiverMesh {
         .collect();
 
     // Components across unconstrained edges.
+    if uniform {
+        let n = triangles.len();
+        return ReceiverMesh {
+            eval: positions.clone(),
+            positions,
+            triangles,
+            tri_region: vec![0; n],
+            regions: Vec::new(),
+        };
+    }
     let mut comp = vec![u32::MAX; faces.len()];
     let mut regions: Vec<RegionFace> = Vec::new();
     for start in 0..faces.len() {

@@ -81,8 +81,14 @@ impl<'a> Indexed<'a> {
                 continue;
             }
             if p.umbra {
+                // Keep the occluder: a vertex where umbra meets light without a D0 split
+                // needs it to compute its value exactly.
                 relations[l] = Relation::Umbra;
-                blockers[l].clear();
+                if p.occluder != crate::edges::BEHIND_LIGHT {
+                    blockers[l] = vec![p.occluder];
+                } else {
+                    blockers[l].clear();
+                }
             } else {
                 relations[l] = Relation::Penumbra;
                 blockers[l].push(p.occluder);
@@ -111,7 +117,23 @@ pub struct RegionTimes {
     pub t_div: f64,
 }
 
-pub fn build_regions(r: &Face, sh: &ReceiverShadows, diag: f64) -> (ReceiverRegions, RegionTimes) {
+pub fn build_regions(
+    r: &Face,
+    sh: &ReceiverShadows,
+    diag: f64,
+    uniform: bool,
+) -> (ReceiverRegions, RegionTimes) {
+    if uniform {
+        return (
+            uniform_regions(r, sh, diag),
+            RegionTimes {
+                t_idd: 0.0,
+                t_lop: 0.0,
+                t_lit: 0.0,
+                t_div: 0.0,
+            },
+        );
+    }
     let t0 = std::time::Instant::now();
     let mut segs = Vec::new();
     for (k, p) in sh.polys.iter().enumerate() {
@@ -203,6 +225,53 @@ pub fn build_regions(r: &Face, sh: &ReceiverShadows, diag: f64) -> (ReceiverRegi
             t_div,
         },
     )
+}
+
+/// The whole receiver as one region, for uniform meshing: every light that reaches it is
+/// treated as penumbra with every occluder that shadows any part of it as candidate, so the
+/// light at each vertex is still exact.
+fn uniform_regions(r: &Face, sh: &ReceiverShadows, diag: f64) -> ReceiverRegions {
+    let extent = r
+        .poly2
+        .iter()
+        .map(|p| (*p - r.poly2[0]).length())
+        .fold(0.0, f64::max)
+        .max(diag * 1e-9);
+    let arr = arrangement::build(&r.poly2, &[], 1e-9 * extent);
+    let n = sh.exposure.len();
+    let mut rf = RegionFace {
+        relations: vec![Relation::Lit; n],
+        blockers: vec![Vec::new(); n],
+    };
+    for (l, e) in sh.exposure.iter().enumerate() {
+        if *e == Exposure::Hidden {
+            rf.relations[l] = Relation::Umbra;
+        }
+    }
+    for p in &sh.polys {
+        let l = p.light as usize;
+        if rf.relations[l] == Relation::Umbra && sh.exposure[l] == Exposure::Hidden {
+            continue;
+        }
+        rf.relations[l] = Relation::Penumbra;
+        if p.occluder != crate::edges::BEHIND_LIGHT {
+            rf.blockers[l].push(p.occluder);
+        }
+    }
+    for b in &mut rf.blockers {
+        b.sort_unstable();
+        b.dedup();
+    }
+    let kept = (0..arr.edges.len() as u32).collect();
+    let faces = vec![rf; arr.faces.len()];
+    ReceiverRegions {
+        face: sh.face,
+        arrangement: arr,
+        faces,
+        kept_edges: kept,
+        n_discontinuity: 0,
+        n_regions: 1,
+    }
 }
 
 /// Is segment a–b along an edge of the (convex) boundary? Such segments are the boundary

@@ -29,6 +29,8 @@ pub struct Settings {
     pub ambient: bool,
     pub lighting_only: bool,
     pub penumbra_visibility: PenumbraVisibility,
+    /// Mesh uniformly instead of along discontinuities (for comparisons).
+    pub uniform: bool,
     pub penumbra_samples: u32,
     pub visibility_rays: u32,
     pub threads: Option<u32>,
@@ -51,11 +53,13 @@ impl Settings {
             (element_size / 5.0).min(element_size),
         )?;
         let patch_size = positive("patch_size", s.patch_size, element_size * 2.0)?;
+        // Only values the user gave: a derived default follows from one of these.
         for (name, v) in [
-            ("element_size", element_size),
-            ("penumbra_element_size", penumbra_element_size),
-            ("patch_size", patch_size),
+            ("element_size", s.element_size),
+            ("penumbra_element_size", s.penumbra_element_size),
+            ("patch_size", s.patch_size),
         ] {
+            let Some(v) = v else { continue };
             if v < diag * 1e-7 {
                 return Err(BakeError::setting(
                     name,
@@ -81,6 +85,16 @@ impl Settings {
                 format!("{convergence} must be in (0, 1)"),
             ));
         }
+        let uniform = match s.meshing.as_deref() {
+            None | Some("discontinuity") => false,
+            Some("uniform") => true,
+            Some(o) => {
+                return Err(BakeError::setting(
+                    "meshing",
+                    format!("{o:?} is not \"discontinuity\" or \"uniform\""),
+                ))
+            }
+        };
         let penumbra_visibility = match s.penumbra_visibility.as_deref() {
             None | Some("exact") => PenumbraVisibility::Exact,
             Some("sampled") => PenumbraVisibility::Sampled,
@@ -126,6 +140,7 @@ impl Settings {
             ambient: s.ambient.unwrap_or(false),
             lighting_only: s.lighting_only.unwrap_or(false),
             penumbra_visibility,
+            uniform,
             penumbra_samples,
             visibility_rays,
             threads: s.threads,

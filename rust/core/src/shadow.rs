@@ -529,6 +529,7 @@ mod test {
             position: DVec3::new(0., 0., 2.),
             intensity: DVec3::ONE,
             spot: None,
+            radius: 0.0,
         };
         let occ = face(square(DVec3::new(0., 0., 1.), 0.5, true));
         let sv = shadow_volumes(&kind, None, 0, &occ, 1e-12).unwrap();

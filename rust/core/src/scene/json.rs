@@ -55,6 +55,9 @@ pub struct LightJson {
     pub intensity: Option<[f64; 3]>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spot: Option<SpotJson>,
+    /// Point/spot only: radius of Blender's soft falloff (irradiance I·cos/(d² + r²)).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub direction: Option<[f64; 3]>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -98,6 +101,10 @@ pub struct SettingsJson {
     pub lighting_only: Option<bool>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub penumbra_visibility: Option<String>,
+    /// "discontinuity" (default) or "uniform": a uniform mesh of `element_size`, with exact
+    /// light at its vertices, for comparisons.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub meshing: Option<String>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub penumbra_samples: Option<u32>,
     #[serde(default, skip_serializing_if = "Option::is_none")]

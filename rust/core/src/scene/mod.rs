@@ -60,6 +60,9 @@ pub enum LightKind {
         position: DVec3,
         intensity: DVec3,
         spot: Option<Spot>,
+        /// Blender's soft falloff for a light of this radius: intensity · cos / (d² + r²)
+        /// (Cycles treats such a point as a disk facing the receiver). Shadows stay hard.
+        radius: f64,
     },
     /// A directional light: `direction` is where the light travels (unit), `irradiance` on a
     /// surface facing it (W/m²).

@@ -369,10 +369,19 @@ fn validate_light(li: usize, l: &LightJson, obj: &str) -> Result<Light, BakeErro
                 })
             }
         };
+        let radius = l.radius.unwrap_or(0.0);
+        if !(radius.is_finite() && radius >= 0.0 && radius <= MAX_COORD) {
+            return Err(BakeError::invalid(
+                obj,
+                "radius",
+                format!("{radius} must be a finite length ≥ 0"),
+            ));
+        }
         LightKind::Point {
             position,
             intensity,
             spot,
+            radius,
         }
     } else {
         let d = check_point(obj, "direction", l.direction.unwrap())?;

@@ -1,0 +1,160 @@
+//! Stage 7: direct light at every element vertex, driven by the relations (paper 2.6 (1)).
+//! A vertex takes the relations of the triangles around it (after the D0 split, only those
+//! of its own side): umbra everywhere → nothing to do; lit everywhere → the unoccluded
+//! integral; otherwise the exact visible part of the light, with only the occluders whose
+//! penumbra contains one of those triangles as candidates.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::direct;
+use crate::elements::Elements;
+use crate::relation::Relation;
+use crate::scene::solids::Occluder;
+use crate::scene::{LightKind, Scene};
+
+/// Direct irradiance (W/m², RGB) per vertex, and the vertex×light counts
+/// (umbra skipped, lit, penumbra).
+pub fn direct_irradiance(
+    scene: &Scene,
+    el: &Elements,
+    progress: &crate::Progress,
+) -> Result<(Vec<DVec3>, [u64; 3]), crate::BakeError> {
+    let nv = el.positions.len();
+    // Regions around each vertex (CSR).
+    let mut count = vec![0u32; nv + 1];
+    for t in &el.triangles {
+        for &v in t {
+            count[v as usize + 1] += 1;
+        }
+    }
+    for i in 0..nv {
+        count[i + 1] += count[i];
+    }
+    let mut fill = count.clone();
+    let mut around = vec![0u32; count[nv] as usize];
+    for (ti, t) in el.triangles.iter().enumerate() {
+        for &v in t {
+            around[fill[v as usize] as usize] = el.tri_region[ti];
+            fill[v as usize] += 1;
+        }
+    }
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let results: Vec<(DVec3, [u64; 3])> = (0..nv)
+        .into_par_iter()
+        .map(|v| {
+            let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            if k % 4096 == 0 {
+                progress.set_fraction(k as f64 / nv as f64);
+            }
+            if progress.is_cancelled() {
+                return (DVec3::ZERO, [0; 3]);
+            }
+            let mut regions: Vec<u32> = around[count[v] as usize..count[v + 1] as usize].to_vec();
+            regions.sort_unstable();
+            regions.dedup();
+            vertex_direct(scene, el, v, &regions)
+        })
+        .collect();
+    progress.check()?;
+    let mut counts = [0u64; 3];
+    let e = results
+        .into_iter()
+        .map(|(e, c)| {
+            for k in 0..3 {
+                counts[k] += c[k];
+            }
+            e
+        })
+        .collect();
+    Ok((e, counts))
+}
+
+fn vertex_direct(scene: &Scene, el: &Elements, v: usize, regions: &[u32]) -> (DVec3, [u64; 3]) {
+    let p = el.eval[v];
+    let n = el.normals[v];
+    let mut e = DVec3::ZERO;
+    let mut counts = [0u64; 3];
+    let mut occ: Vec<u32> = Vec::new();
+    for (li, light) in scene.lights.iter().enumerate() {
+        let rels = regions
+            .iter()
+            .map(|&r| el.regions[r as usize].relations[li]);
+        let all = |want: Relation| rels.clone().all(|r| r == want);
+        let relation = if regions.is_empty() || all(Relation::Umbra) {
+            Relation::Umbra
+        } else if all(Relation::Lit) {
+            Relation::Lit
+        } else {
+            Relation::Penumbra
+        };
+        match relation {
+            Relation::Umbra => {
+                counts[0] += 1;
+                continue;
+            }
+            Relation::Lit => counts[1] += 1,
+            _ => counts[2] += 1,
+        }
+        occ.clear();
+        if relation == Relation::Penumbra {
+            for &r in regions {
+                occ.extend_from_slice(&el.regions[r as usize].blockers[li]);
+            }
+            occ.sort_unstable();
+            occ.dedup();
+        }
+        // A solid hides exactly what its faces turned towards p hide.
+        let polys: Vec<&[DVec3]> = occ
+            .iter()
+            .flat_map(|&o| {
+                scene.occluders[o as usize]
+                    .faces()
+                    .iter()
+                    .map(move |&f| (o, f))
+            })
+            .filter(|&(o, f)| match &scene.occluders[o as usize] {
+                Occluder::Face(_) => true,
+                Occluder::Solid { .. } => scene.faces[f as usize].plane.dist(p) > 0.0,
+            })
+            .map(|(_, f)| scene.faces[f as usize].verts.as_slice())
+            .collect();
+        e += match &light.kind {
+            LightKind::Area {
+                verts,
+                plane,
+                radiance,
+            } => direct::area_light(
+                p,
+                n,
+                verts,
+                plane,
+                *radiance,
+                relation,
+                &polys,
+                scene.settings.penumbra_visibility,
+                scene.settings.penumbra_samples,
+            ),
+            LightKind::Point {
+                position,
+                intensity,
+                spot,
+                radius,
+            } => {
+                let d2 = (*position - p).length_squared();
+                let soft = if *radius > 0.0 {
+                    d2 / (d2 + radius * radius)
+                } else {
+                    1.0
+                };
+                direct::point_light(p, n, *position, *intensity, spot.as_ref(), relation, &polys)
+                    * soft
+            }
+            LightKind::Sun {
+                direction,
+                irradiance,
+            } => direct::sun_light(p, n, *direction, *irradiance, relation, &polys),
+        };
+    }
+    (e, counts)
+}

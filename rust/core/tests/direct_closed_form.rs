@@ -1,0 +1,76 @@
+//! Direct light on the square-over-floor scene against the closed form: the light (side 1,
+//! z = 2) seen from a floor point minus the rectangle the occluder (side 0.8, z = 1) hides,
+//! each integrated with the corner formula for a rectangle parallel to the receiver.
+
+mod common;
+use common::*;
+use std::f64::consts::PI;
+
+/// Irradiance from a unit-radiance rectangle at height h whose corner is straight above the
+/// point, extending a × b (the classic corner form factor, times π).
+fn corner(a: f64, b: f64, h: f64) -> f64 {
+    let (a, b) = (a / h, b / h);
+    let (sa, sb) = ((1.0 + a * a).sqrt(), (1.0 + b * b).sqrt());
+    0.5 * (a / sa * (b / sa).atan() + b / sb * (a / sb).atan())
+}
+
+fn signed_corner(x: f64, y: f64, h: f64) -> f64 {
+    x.signum() * y.signum() * corner(x.abs(), y.abs(), h)
+}
+
+/// Irradiance at (px, py, 0) from the unit-radiance rectangle [x0,x1]×[y0,y1] at height h.
+fn rect(px: f64, py: f64, [x0, x1, y0, y1]: [f64; 4], h: f64) -> f64 {
+    if x1 <= x0 || y1 <= y0 {
+        return 0.0;
+    }
+    let g = |x: f64, y: f64| signed_corner(x - px, y - py, h);
+    g(x1, y1) - g(x0, y1) - g(x1, y0) + g(x0, y0)
+}
+
+#[test]
+fn penumbra_values_match_rectangle_difference() {
+    let radiance = 3.0;
+    let mut light = area_light("Light", quad([0., 0., 2.], 0.5, 0.5, false));
+    light.radiance = Some([radiance; 3]);
+    let s = scene(
+        vec![
+            mesh("Floor", vec![quad([0., 0., 0.], 3., 3., true)]),
+            mesh("Occluder", vec![quad([0., 0., 1.], 0.4, 0.4, true)]),
+        ],
+        vec![light],
+        penumbra::scene::json::SettingsJson {
+            indirect: Some(false),
+            lighting_only: Some(true),
+            ..Default::default()
+        },
+    );
+    let b = bake(&s);
+    let floor = &b.meshes[0];
+    let mut worst: f64 = 0.0;
+    let mut n_pen = 0;
+    for (v, c) in floor.positions.iter().zip(&floor.colors) {
+        let (x, y) = (v[0], v[1]);
+        let full = rect(x, y, [-0.5, 0.5, -0.5, 0.5], 2.0);
+        // From (x, y, 0) the occluder at z = 1 hides light points l with (p + l)/2 inside it.
+        let hid = rect(
+            x,
+            y,
+            [
+                (-0.8 - x).max(-0.5),
+                (0.8 - x).min(0.5),
+                (-0.8 - y).max(-0.5),
+                (0.8 - y).min(0.5),
+            ],
+            2.0,
+        );
+        let want = radiance * (full - hid);
+        let got = c[0] * PI;
+        worst = worst.max((got - want).abs() / (radiance * full));
+        if hid > 0.0 && hid < full {
+            n_pen += 1;
+        }
+        assert!(c[0] == c[1] && c[1] == c[2]);
+    }
+    assert!(n_pen > 200, "only {n_pen} penumbra vertices");
+    assert!(worst < 1e-9, "worst relative error {worst:e}");
+}
