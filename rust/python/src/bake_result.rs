@@ -28,17 +28,15 @@ pub fn to_py_dict<'py>(
 fn mesh<'py>(py: Python<'py>, m: &BakedMesh, n_lights: usize) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("name", &m.name)?;
-    d.set_item(
-        "positions",
-        PyArray1::from_slice(py, m.positions.as_flattened()).reshape([m.positions.len(), 3])?,
-    )?;
-    d.set_item(
-        "triangles",
-        PyArray1::from_slice(py, m.triangles.as_flattened()).reshape([m.triangles.len(), 3])?,
-    )?;
+    let positions = PyArray1::from_slice(py, m.positions.as_flattened());
+    d.set_item("positions", positions.reshape([m.positions.len(), 3])?)?;
+    let triangles = PyArray1::from_slice(py, m.triangles.as_flattened());
+    d.set_item("triangles", triangles.reshape([m.triangles.len(), 3])?)?;
+    // Python's contract is float32 colours (what Blender stores), whatever the core keeps.
+    let colors: Vec<f32> = m.colors.as_flattened().iter().map(|&c| c as f32).collect();
     d.set_item(
         "colors",
-        PyArray1::from_slice(py, m.colors.as_flattened()).reshape([m.colors.len(), 3])?,
+        PyArray1::from_vec(py, colors).reshape([m.colors.len(), 3])?,
     )?;
     d.set_item(
         "source_polygon",
