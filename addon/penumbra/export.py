@@ -1,0 +1,185 @@
+"""Blender → scene arrays for ``penumbra._core``: the selected meshes evaluated with their
+modifiers, in world space, and the lights in scene-JSON form. Only numpy and
+``foreach_get`` touch mesh data; nothing here changes the Blender scene.
+"""
+
+import bpy
+import numpy as np
+
+from .props import QUALITY_FRACTIONS
+
+from .cycles_lights import lights_to_scene
+from .materials import polygon_colors
+
+# Custom property of a baked object: the name of the object it was baked from.
+SOURCE_KEY = "penumbra_source"
+
+# Object types that evaluate to a mesh.
+MESH_TYPES = {"MESH", "CURVE", "SURFACE", "FONT", "META"}
+
+
+class ExportError(Exception):
+    """Bad input found before the bake: the message names the object and the field."""
+
+
+class Export:
+    """What a bake needs: the scene for the core and the source objects, in mesh order."""
+
+    def __init__(self, scene, sources, lights, warnings):
+        self.scene = scene
+        self.sources = sources
+        self.lights = lights
+        # Material features approximated on the way out (from materials.polygon_colors).
+        self.warnings = warnings
+
+
+def export_scene(context, settings, objects=None):
+    """Builds the scene dict from the selection of ``context`` (or from ``objects``).
+
+    Lights are the selected lights, or every visible light when none is selected.
+    Raises ``ExportError`` on bad input.
+    """
+    if objects is None:
+        objects = list(context.selected_objects)
+    sources = _sources(objects)
+    if not sources:
+        raise ExportError("Nothing selected: select the meshes to bake")
+    lights = [o for o in objects if o.type == "LIGHT"]
+    if not lights:
+        lights = [
+            o
+            for o in context.view_layer.objects
+            if o.type == "LIGHT" and o.visible_get() and not o.hide_render
+        ]
+    depsgraph = context.evaluated_depsgraph_get()
+
+    warnings = []
+    meshes = [_mesh(o, depsgraph, warnings) for o in sources]
+    light_dicts = []
+    for o in lights:
+        light_dicts.extend(_light(o, depsgraph))
+    emissive = any(np.any(np.asarray(m["emission"]) > 0.0) for m in meshes)
+    if not light_dicts and not emissive:
+        raise ExportError("No lights: add a light or select one (or give a material emission)")
+
+    scene = {"meshes": meshes, "lights": light_dicts, "settings": _settings(settings, meshes, light_dicts)}
+    return Export(scene, sources, lights, warnings)
+
+
+def _sources(objects):
+    """The meshes to bake. A baked object stands for its source, so that selecting a bake
+    and baking again re-bakes the (possibly hidden) original; baked objects themselves are
+    never baked, they would lie on top of their sources."""
+    out = []
+    for o in objects:
+        if o.type not in MESH_TYPES:
+            continue
+        if SOURCE_KEY in o.keys():
+            o = bpy.data.objects.get(o[SOURCE_KEY])
+            if o is None or o.type not in MESH_TYPES:
+                continue
+        if o not in out:
+            out.append(o)
+    return out
+
+
+def _mesh(obj, depsgraph, warnings):
+    obj_eval = obj.evaluated_get(depsgraph)
+    mesh = obj_eval.to_mesh()
+    try:
+        n_vert = len(mesh.vertices)
+        co = np.empty(n_vert * 3, dtype=np.float32)
+        mesh.vertices.foreach_get("co", co)
+        local = co.reshape(-1, 3).astype(np.float64)
+        m = np.array(obj_eval.matrix_world, dtype=np.float64)
+        positions = local @ m[:3, :3].T + m[:3, 3]
+        bad = ~np.isfinite(positions).all(axis=1)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise ExportError(
+                'Object "%s": vertex positions: vertex %d is %s (not a finite number)'
+                % (obj.name, i, tuple(float(x) for x in local[i]))
+            )
+
+        n_poly = len(mesh.polygons)
+        starts = np.empty(n_poly, dtype=np.int64)
+        counts = np.empty(n_poly, dtype=np.int64)
+        mesh.polygons.foreach_get("loop_start", starts)
+        mesh.polygons.foreach_get("loop_total", counts)
+        loop_vert = np.empty(len(mesh.loops), dtype=np.int64)
+        mesh.loops.foreach_get("vertex_index", loop_vert)
+        polygon_vertices = loop_vert[_loop_order(starts, counts, np.linalg.det(m[:3, :3]) < 0.0)]
+
+        albedo, emission = polygon_colors(obj_eval, mesh, warnings)
+        return {
+            "name": obj.name,
+            "positions": positions,
+            "polygon_vertices": polygon_vertices,
+            "polygon_counts": counts,
+            "albedo": np.asarray(albedo, dtype=np.float64).reshape(-1, 3),
+            "emission": np.asarray(emission, dtype=np.float64).reshape(-1, 3),
+        }
+    finally:
+        obj_eval.to_mesh_clear()
+
+
+def _loop_order(starts, counts, mirrored):
+    """Loop indices polygon after polygon. A mirroring transform turns counter-clockwise
+    into clockwise, so then each polygon's loops are reversed to keep its front."""
+    total = int(counts.sum())
+    offsets = np.concatenate(([0], np.cumsum(counts)[:-1])) if len(counts) else counts
+    within = np.arange(total) - np.repeat(offsets, counts)
+    if mirrored:
+        within = np.repeat(counts, counts) - 1 - within
+    return np.repeat(starts, counts) + within
+
+
+def _light(obj, depsgraph):
+    light = obj.data
+    if light.type == "AREA":
+        sizes = [("size", light.size)]
+        if light.shape in {"RECTANGLE", "ELLIPSE"}:
+            sizes.append(("size_y", light.size_y))
+        for field, value in sizes:
+            if not value > 0.0:
+                raise ExportError('Light "%s": %s is %g: an area light needs a size above 0' % (obj.name, field, value))
+        scale = obj.matrix_world.to_scale()
+        if abs(scale.x * scale.y) <= 0.0:
+            raise ExportError('Light "%s": scale: the area light is scaled to zero size' % obj.name)
+    try:
+        dicts = lights_to_scene(obj, depsgraph)
+    except ValueError as e:  # a light feature the scene JSON cannot hold; names light and field
+        raise ExportError(str(e))
+    for d in dicts:
+        polygon = d.get("polygon")
+        if polygon is not None and _polygon_area(np.asarray(polygon, dtype=np.float64)) <= 0.0:
+            raise ExportError('Light "%s": size: the light polygon has no area' % obj.name)
+    return dicts
+
+
+def _polygon_area(p):
+    if len(p) < 3 or not np.isfinite(p).all():
+        return 0.0
+    return 0.5 * float(np.linalg.norm(np.cross(p - p[0], np.roll(p, -1, axis=0) - p[0]).sum(axis=0)))
+
+
+def _settings(settings, meshes, lights):
+    pts = [m["positions"] for m in meshes if len(m["positions"])]
+    for d in lights:
+        for key in ("polygon", "point"):
+            if d.get(key) is not None:
+                pts.append(np.asarray(d[key], dtype=np.float64).reshape(-1, 3))
+    allp = np.concatenate(pts) if pts else np.zeros((1, 3))
+    diag = float(np.linalg.norm(allp.max(axis=0) - allp.min(axis=0))) or 1.0
+    if settings.use_custom_size:
+        element, penumbra = settings.element_size, settings.penumbra_element_size
+    else:
+        coarse, fine = QUALITY_FRACTIONS[settings.quality]
+        element, penumbra = coarse * diag, fine * diag
+    return {
+        "element_size": float(element),
+        "penumbra_element_size": float(min(penumbra, element)),
+        "indirect": bool(settings.use_indirect),
+        "convergence": float(settings.convergence),
+        "lighting_only": bool(settings.lighting_only),
+    }

@@ -1,0 +1,163 @@
+"""The "Bake Radiosity" operator. With a UI it is modal: the bake runs on the Rust thread
+while a timer polls its progress, so Blender stays responsive and ESC cancels. Without a
+UI (``blender -b``, the bpy module) it bakes synchronously. Either way the scene changes
+only when a bake succeeds, in one undo step.
+"""
+
+import json
+import time
+
+import bpy
+
+from . import _core
+from .export import ExportError, export_scene
+from .import_ import import_bake
+
+# Words of the core's stage names ("shadow volumes", "discontinuity loops", "meshing", ...)
+# in pipeline order, for one overall progress bar.
+STAGES = ("validate", "shadow", "loop", "mesh", "direct", "indirect", "output")
+
+
+def prepare(context, report):
+    """The exported scene, or None after reporting why there is nothing sane to bake."""
+    try:
+        return export_scene(context, context.scene.penumbra)
+    except ExportError as e:
+        report({"ERROR"}, str(e))
+        return None
+
+
+def finish(context, export, result, seconds, report):
+    """Turns a finished bake into objects and reports a one-line summary."""
+    sources = []
+    for obj in export.sources:
+        try:
+            sources.append(bpy.data.objects.get(obj.name))
+        except ReferenceError:  # deleted while the bake ran
+            sources.append(None)
+    pairs = [(m, s) for m, s in zip(result["meshes"], sources) if s is not None]
+    settings = context.scene.penumbra
+    created = import_bake(context, {"meshes": [m for m, _ in pairs]}, [s for _, s in pairs], settings.hide_originals)
+
+    stats = result["stats"]
+    elements = stats.get("N_e") or sum(len(m["triangles"]) for m in result["meshes"])
+    vertices = stats.get("N_v") or sum(len(m["positions"]) for m in result["meshes"])
+    summary = "Penumbra: baked %d object%s, %d elements, %d vertices in %.2f s" % (
+        len(created),
+        "" if len(created) == 1 else "s",
+        elements,
+        vertices,
+        seconds,
+    )
+    warnings = list(export.warnings) + list(result["warnings"])
+    if warnings:
+        summary += " (%d warning%s, see console)" % (len(warnings), "" if len(warnings) == 1 else "s")
+        for w in warnings:
+            print("Penumbra warning:", w)
+    settings.last_summary = summary
+    settings.last_stats = json.dumps(dict(stats, seconds=seconds))
+    report({"INFO"}, summary)
+    return {"FINISHED"}
+
+
+def bake_blocking(context, report):
+    """The whole bake on the calling thread (GIL released while the core runs)."""
+    export = prepare(context, report)
+    if export is None:
+        return {"CANCELLED"}
+    t0 = time.perf_counter()
+    try:
+        result = _core.bake(export.scene)
+    except _core.BakeError as e:
+        report({"ERROR"}, "Penumbra: %s" % e)
+        return {"CANCELLED"}
+    return finish(context, export, result, time.perf_counter() - t0, report)
+
+
+def has_ui(context):
+    """False in ``blender -b`` and in the bpy module: there the bake runs synchronously."""
+    return not bpy.app.background and context.window is not None
+
+
+def overall_fraction(stage, fraction):
+    """Progress of the whole bake in [0, 1]; 0 for a stage this add-on does not know."""
+    name = stage.lower()
+    # "indirect" contains "direct": look for it first.
+    keys = sorted(STAGES, key=lambda k: k != "indirect")
+    for key in keys:
+        if key in name:
+            return (STAGES.index(key) + fraction) / len(STAGES)
+    return 0.0
+
+
+class PENUMBRA_OT_bake(bpy.types.Operator):
+    """Bake direct and indirect light of the selected meshes onto new meshes that follow the shadow boundaries"""
+
+    bl_idname = "penumbra.bake"
+    bl_label = "Bake Radiosity"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        return context.scene is not None
+
+    def execute(self, context):
+        return bake_blocking(context, self.report)
+
+    def invoke(self, context, event):
+        if not has_ui(context):
+            return self.execute(context)
+        self._export = prepare(context, self.report)
+        if self._export is None:
+            return {"CANCELLED"}
+        try:
+            self._job = _core.start_bake(self._export.scene)
+        except _core.BakeError as e:
+            self.report({"ERROR"}, "Penumbra: %s" % e)
+            return {"CANCELLED"}
+        self._t0 = time.perf_counter()
+        self._shown = 0.0
+        wm = context.window_manager
+        self._timer = wm.event_timer_add(0.1, window=context.window)
+        wm.progress_begin(0, 1000)
+        wm.modal_handler_add(self)
+        return {"RUNNING_MODAL"}
+
+    def modal(self, context, event):
+        if event.type == "ESC" and event.value == "PRESS":
+            self._job.cancel()
+            self._end(context)
+            self.report({"WARNING"}, "Penumbra: bake cancelled, nothing changed")
+            return {"CANCELLED"}
+        if event.type != "TIMER":
+            return {"PASS_THROUGH"}
+        stage, fraction = self._job.progress()
+        # Never backwards, even past a stage this add-on does not know.
+        self._shown = max(self._shown, overall_fraction(stage, fraction))
+        context.window_manager.progress_update(int(1000 * self._shown))
+        context.workspace.status_text_set(
+            "Penumbra: %s %d%%  (Esc to cancel)" % (stage, int(round(100 * fraction)))
+        )
+        if not self._job.done():
+            return {"RUNNING_MODAL"}
+        self._end(context)
+        try:
+            result = self._job.result()
+        except _core.BakeError as e:
+            self.report({"ERROR"}, "Penumbra: %s" % e)
+            return {"CANCELLED"}
+        return finish(context, self._export, result, time.perf_counter() - self._t0, self.report)
+
+    def _end(self, context):
+        wm = context.window_manager
+        wm.event_timer_remove(self._timer)
+        wm.progress_end()
+        context.workspace.status_text_set(None)
+
+
+def register():
+    bpy.utils.register_class(PENUMBRA_OT_bake)
+
+
+def unregister():
+    bpy.utils.unregister_class(PENUMBRA_OT_bake)

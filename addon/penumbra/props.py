@@ -1,0 +1,84 @@
+"""Bake settings, stored on the scene (``scene.penumbra``)."""
+
+import bpy
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, PointerProperty, StringProperty
+
+# Element edge lengths as fractions of the scene's bounding-box diagonal: (outside penumbra,
+# inside penumbra). Medium is the core's own default.
+QUALITY_FRACTIONS = {
+    "DRAFT": (1.0 / 12.0, 1.0 / 40.0),
+    "MEDIUM": (1.0 / 25.0, 1.0 / 125.0),
+    "HIGH": (1.0 / 50.0, 1.0 / 400.0),
+}
+
+
+class PenumbraSettings(bpy.types.PropertyGroup):
+    quality: EnumProperty(
+        name="Quality",
+        description="Element size relative to the size of the baked scene",
+        items=(
+            ("DRAFT", "Draft", "Coarse elements: a quick look"),
+            ("MEDIUM", "Medium", "Balanced"),
+            ("HIGH", "High", "Fine elements, sharp penumbrae; slower"),
+        ),
+        default="MEDIUM",
+    )
+    use_custom_size: BoolProperty(
+        name="Custom Element Size",
+        description="Set element edge lengths in scene units instead of from the quality preset",
+        default=False,
+    )
+    element_size: FloatProperty(
+        name="Element Size",
+        description="Element edge length outside penumbrae",
+        default=0.2,
+        min=1e-6,
+        soft_max=10.0,
+        subtype="DISTANCE",
+        unit="LENGTH",
+    )
+    penumbra_element_size: FloatProperty(
+        name="Penumbra Element Size",
+        description="Element edge length inside penumbrae, where light changes fast",
+        default=0.04,
+        min=1e-6,
+        soft_max=10.0,
+        subtype="DISTANCE",
+        unit="LENGTH",
+    )
+    use_indirect: BoolProperty(
+        name="Indirect Light",
+        description="Add light bounced between surfaces (progressive refinement radiosity)",
+        default=True,
+    )
+    convergence: FloatProperty(
+        name="Convergence",
+        description="Stop shooting when the unshot power falls below this fraction of the emitted power",
+        default=1e-3,
+        min=1e-6,
+        max=0.5,
+        precision=4,
+    )
+    lighting_only: BoolProperty(
+        name="Lighting Only",
+        description="Bake irradiance/π without surface colour (a lightmap to multiply by albedo later)",
+        default=False,
+    )
+    hide_originals: BoolProperty(
+        name="Hide Originals",
+        description="Hide the source objects after the bake, in the viewport and in renders",
+        default=False,
+    )
+    # Written by the last successful bake, read by the panel and by scripts.
+    last_summary: StringProperty(name="Last Bake", default="")
+    last_stats: StringProperty(name="Last Bake Stats (JSON)", default="")
+
+
+def register():
+    bpy.utils.register_class(PenumbraSettings)
+    bpy.types.Scene.penumbra = PointerProperty(type=PenumbraSettings)
+
+
+def unregister():
+    del bpy.types.Scene.penumbra
+    bpy.utils.unregister_class(PenumbraSettings)

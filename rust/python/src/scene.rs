@@ -1,0 +1,251 @@
+//! A scene from Python: scene JSON text, or a dict whose meshes are numpy arrays in
+//! Blender's layout (vertex positions, polygon vertex indices flattened as Blender's loops,
+//! per-polygon counts). Both end as the core's `SceneJson`; all value checks stay in the core.
+
+use numpy::{AllowTypeChange, PyArrayLikeDyn, PyUntypedArrayMethods};
+use penumbra::scene::json::{
+    LightJson, MeshJson, PerPolygon, SceneJson, SettingsJson, SCENE_FORMAT, SCENE_VERSION,
+};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString};
+use serde_json::Value;
+
+use crate::error::{invalid, Error};
+use crate::value::to_value;
+
+const SCENE_KEYS: &[&str] = &["format", "version", "meshes", "lights", "settings"];
+const MESH_KEYS: &[&str] = &[
+    "name",
+    "positions",
+    "polygon_vertices",
+    "polygon_counts",
+    "albedo",
+    "emission",
+];
+
+pub fn from_py(scene: &Bound<'_, PyAny>) -> Result<SceneJson, Error> {
+    if let Ok(text) = scene.cast::<PyString>() {
+        return Ok(SceneJson::from_str(&text.to_string())?);
+    }
+    let dict = scene
+        .cast::<PyDict>()
+        .map_err(|_| invalid("scene", "", "expected scene JSON text or a dict"))?;
+    check_keys(dict, SCENE_KEYS, "scene")?;
+    if let Some(f) = dict.get_item("format").ok().flatten() {
+        let f: String = f
+            .extract()
+            .map_err(|_| invalid("scene", "format", "not a string"))?;
+        if f != SCENE_FORMAT {
+            return Err(penumbra::BakeError::Format(format!(
+                "format is {f:?}, expected {SCENE_FORMAT:?}"
+            ))
+            .into());
+        }
+    }
+    if let Some(v) = dict.get_item("version").ok().flatten() {
+        let v: u32 = v
+            .extract()
+            .map_err(|_| invalid("scene", "version", "not an integer"))?;
+        if v != SCENE_VERSION {
+            return Err(penumbra::BakeError::Format(format!(
+                "version {v} is not supported (this build reads version {SCENE_VERSION})"
+            ))
+            .into());
+        }
+    }
+    let mut meshes = Vec::new();
+    if let Some(list) = dict.get_item("meshes").ok().flatten() {
+        for (i, m) in iter(&list, "scene", "meshes")?.enumerate() {
+            meshes.push(mesh(&m?, i)?);
+        }
+    }
+    let mut lights = Vec::new();
+    if let Some(list) = dict.get_item("lights").ok().flatten() {
+        for (i, l) in iter(&list, "scene", "lights")?.enumerate() {
+            lights.push(light(&l?, i)?);
+        }
+    }
+    let settings = match dict.get_item("settings").ok().flatten() {
+        Some(s) if !s.is_none() => {
+            let v = to_value(&s, "settings", "")?;
+            serde_json::from_value::<SettingsJson>(v)
+                .map_err(|e| invalid("settings", "", e.to_string()))?
+        }
+        _ => SettingsJson::default(),
+    };
+    Ok(SceneJson {
+        format: SCENE_FORMAT.into(),
+        version: SCENE_VERSION,
+        meshes,
+        lights,
+        settings,
+    })
+}
+
+fn iter<'py>(
+    obj: &Bound<'py, PyAny>,
+    object: &str,
+    field: &str,
+) -> Result<impl Iterator<Item = Result<Bound<'py, PyAny>, Error>>, Error> {
+    let object = object.to_string();
+    let field2 = field.to_string();
+    let it = obj
+        .try_iter()
+        .map_err(|_| invalid(&object, field, "expected a list"))?;
+    Ok(it.map(move |x| x.map_err(|e| invalid(&object, &field2, e.to_string()))))
+}
+
+fn check_keys(d: &Bound<'_, PyDict>, allowed: &[&str], object: &str) -> Result<(), Error> {
+    for k in d.keys() {
+        let k: String = k
+            .extract()
+            .map_err(|_| invalid(object, "", "keys must be strings"))?;
+        if !allowed.contains(&k.as_str()) {
+            return Err(invalid(
+                object,
+                &k,
+                format!("unknown field (expected one of {})", allowed.join(", ")),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn mesh(obj: &Bound<'_, PyAny>, index: usize) -> Result<MeshJson, Error> {
+    let here = format!("meshes[{index}]");
+    let d = obj
+        .cast::<PyDict>()
+        .map_err(|_| invalid(&here, "", "expected a dict"))?;
+    let name: String = match d.get_item("name").ok().flatten() {
+        Some(n) => n
+            .extract()
+            .map_err(|_| invalid(&here, "name", "not a string"))?,
+        None => return Err(invalid(&here, "name", "missing")),
+    };
+    let object = format!("mesh {name:?} ({here})");
+    check_keys(d, MESH_KEYS, &object)?;
+    let get = |key: &str| -> Result<Bound<'_, PyAny>, Error> {
+        d.get_item(key)
+            .ok()
+            .flatten()
+            .ok_or_else(|| invalid(&object, key, "missing"))
+    };
+
+    let positions = rows3(&get("positions")?, &object, "positions")?;
+    let counts = ints(&get("polygon_counts")?, &object, "polygon_counts")?;
+    let flat = ints(&get("polygon_vertices")?, &object, "polygon_vertices")?;
+    let mut polygons = Vec::with_capacity(counts.len());
+    let mut at = 0usize;
+    for (p, &c) in counts.iter().enumerate() {
+        let c = usize::try_from(c).map_err(|_| {
+            invalid(
+                &object,
+                &format!("polygon_counts[{p}]"),
+                format!("{c} is negative"),
+            )
+        })?;
+        let Some(slice) = flat.get(at..at + c) else {
+            return Err(invalid(
+                &object,
+                "polygon_counts",
+                format!(
+                    "the counts add up to more than the {} polygon_vertices",
+                    flat.len()
+                ),
+            ));
+        };
+        polygons.push(slice.to_vec());
+        at += c;
+    }
+    if at != flat.len() {
+        return Err(invalid(
+            &object,
+            "polygon_counts",
+            format!(
+                "the counts add up to {at}, but there are {} polygon_vertices",
+                flat.len()
+            ),
+        ));
+    }
+    let albedo = match d.get_item("albedo").ok().flatten() {
+        Some(a) if !a.is_none() => Some(per_polygon(&a, &object, "albedo")?),
+        _ => None,
+    };
+    let emission = match d.get_item("emission").ok().flatten() {
+        Some(a) if !a.is_none() => Some(per_polygon(&a, &object, "emission")?),
+        _ => None,
+    };
+    Ok(MeshJson {
+        name,
+        positions,
+        polygons,
+        albedo,
+        emission,
+    })
+}
+
+fn light(obj: &Bound<'_, PyAny>, index: usize) -> Result<LightJson, Error> {
+    let name = obj
+        .get_item("name")
+        .ok()
+        .and_then(|n| n.extract::<String>().ok())
+        .unwrap_or_default();
+    let object = format!("light {name:?} (lights[{index}])");
+    let v: Value = to_value(obj, &object, "")?;
+    serde_json::from_value::<LightJson>(v).map_err(|e| invalid(&object, "", e.to_string()))
+}
+
+/// A numeric array of any dtype (lists too) as f64, with its shape.
+fn array_f64(
+    obj: &Bound<'_, PyAny>,
+    object: &str,
+    field: &str,
+) -> Result<(Vec<usize>, Vec<f64>), Error> {
+    let a: PyArrayLikeDyn<'_, f64, AllowTypeChange> = obj
+        .extract()
+        .map_err(|e| invalid(object, field, format!("not a numeric array: {e}")))?;
+    let shape = a.shape().to_vec();
+    Ok((shape, a.as_array().iter().copied().collect()))
+}
+
+fn rows3(obj: &Bound<'_, PyAny>, object: &str, field: &str) -> Result<Vec<[f64; 3]>, Error> {
+    let (shape, data) = array_f64(obj, object, field)?;
+    let empty = data.is_empty() && shape.first() == Some(&0);
+    if !(shape.len() == 2 && shape[1] == 3) && !empty {
+        return Err(invalid(
+            object,
+            field,
+            format!("expected shape (N, 3), got {shape:?}"),
+        ));
+    }
+    Ok(data.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
+}
+
+fn per_polygon(obj: &Bound<'_, PyAny>, object: &str, field: &str) -> Result<PerPolygon, Error> {
+    let (shape, data) = array_f64(obj, object, field)?;
+    match shape.as_slice() {
+        [3] => Ok(PerPolygon::Uniform([data[0], data[1], data[2]])),
+        [_, 3] | [0] => Ok(PerPolygon::PerPolygon(
+            data.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+        )),
+        _ => Err(invalid(
+            object,
+            field,
+            format!("expected shape (3,) or (P, 3), got {shape:?}"),
+        )),
+    }
+}
+
+fn ints(obj: &Bound<'_, PyAny>, object: &str, field: &str) -> Result<Vec<i64>, Error> {
+    let a: PyArrayLikeDyn<'_, i64, AllowTypeChange> = obj
+        .extract()
+        .map_err(|e| invalid(object, field, format!("not an integer array: {e}")))?;
+    if a.shape().len() != 1 {
+        return Err(invalid(
+            object,
+            field,
+            format!("expected a flat array, got shape {:?}", a.shape()),
+        ));
+    }
+    Ok(a.as_array().iter().copied().collect())
+}
