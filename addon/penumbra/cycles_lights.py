@@ -193,7 +193,7 @@ def lights_to_scene(obj, depsgraph=None, *, disk_segments: int = DEFAULT_DISK_SE
         return _area(name, light, S, X, Y, co, emit, disk_segments)
     if light.type in {"POINT", "SPOT"}:
         r = float(light.shadow_soft_size)
-        if light.normalize:
+        if getattr(light, "normalize", True):
             I = S / (4.0 * math.pi)
         else:
             I = S * r * r if r > 0.0 else S / math.pi
@@ -208,13 +208,13 @@ def lights_to_scene(obj, depsgraph=None, *, disk_segments: int = DEFAULT_DISK_SE
         return [d]
     if light.type == "SUN":
         half = 0.5 * float(light.angle)
-        E = S if (light.normalize or half <= 0.0) else S * math.pi * math.sin(half) ** 2
+        E = S if (getattr(light, "normalize", True) or half <= 0.0) else S * math.pi * math.sin(half) ** 2
         return [{"name": name, "direction": emit.tolist(), "irradiance": E.tolist()}]
     raise UnsupportedLightError(name, "type", f"unknown light type {light.type!r}")
 
 
 def _area(name, light, S, X, Y, co, emit, disk_segments):
-    if light.spread < _FULL_SPREAD - 1e-6:
+    if getattr(light, "spread", _FULL_SPREAD) < _FULL_SPREAD - 1e-6:
         raise UnsupportedLightError(
             name, "spread",
             f"{math.degrees(light.spread):.1f}° < 180°: Cycles narrows the emission by direction "
@@ -227,7 +227,7 @@ def _area(name, light, S, X, Y, co, emit, disk_segments):
         area *= math.pi / 4.0
     if area <= 0.0:
         return []
-    L = S / (math.pi * area) if light.normalize else S / math.pi
+    L = S / (math.pi * area) if getattr(light, "normalize", True) else S / math.pi
     if ellipse:
         if disk_segments < 3:
             raise ValueError("disk_segments must be at least 3")

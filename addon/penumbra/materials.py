@@ -225,6 +225,14 @@ def _closure(sock, warn, where, depth=0):
         return _rgb(inp["Color"], warn, where), zero
     if t == "ShaderNodeEmission":
         return zero, _rgb(inp["Color"], warn, where) * _float(inp["Strength"], warn, where)
+    if t == "ShaderNodeBsdfPrincipled" and "Transmission Weight" not in inp:
+        # Blender < 4.0 (Principled v1, e.g. Debian's 3.4): its diffuse lobe is the base
+        # colour times (1 − metallic)(1 − transmission), with no specular energy taken off.
+        f = lambda name: _float(inp[name], warn, where)  # noqa: E731
+        albedo = (_rgb(inp["Base Color"], warn, where) * (1.0 - f("Metallic"))
+                  * (1.0 - f("Transmission")) * f("Alpha"))
+        emission = _rgb(inp["Emission"], warn, where) * f("Emission Strength")
+        return np.clip(albedo, 0.0, 1.0), emission
     if t == "ShaderNodeBsdfPrincipled":
         f = lambda name: _float(inp[name], warn, where)  # noqa: E731
         albedo = principled_diffuse_albedo(

@@ -25,6 +25,9 @@ def prepare(context, report):
     except ExportError as e:
         report({"ERROR"}, str(e))
         return None
+    except Exception as e:  # noqa: BLE001 - a report, never a traceback; nothing changed yet
+        report({"ERROR"}, "Penumbra: could not read the scene: %s: %s" % (type(e).__name__, e))
+        return None
 
 
 def finish(context, export, result, seconds, report):
