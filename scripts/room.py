@@ -52,7 +52,7 @@ def _boxes(name, boxes, material, collection):
     return _object(name, verts, faces, material, collection)
 
 
-def build_room(scene=None, light_power=150.0):
+def build_room(scene=None, light_power=80.0):
     """Adds the room to ``scene`` (default: the context scene); returns (meshes, light)."""
     scene = scene or bpy.context.scene
     coll = bpy.data.collections.new("Room")
