@@ -16,6 +16,11 @@ import numpy as np
 def polygon_lattice(poly: np.ndarray, spacing: float):
     """Lattice of one convex polygon (k, 3) → (vertices (V,3), triangles (T,3), interior mask)."""
     k = len(poly)
+    c = poly.mean(0)
+    if np.max(np.linalg.norm(poly - c, axis=1)) < 0.5 * spacing:
+        # Smaller than one lattice cell: one probe at the centre, fanned to the corners.
+        tris = np.array([(i, (i + 1) % k, k) for i in range(k)], dtype=np.int64)
+        return np.vstack([poly, c]), tris, np.r_[np.zeros(k, bool), True]
     verts: list[np.ndarray] = []
     index: dict[tuple, int] = {}
     tris: list[tuple[int, int, int]] = []
