@@ -12,6 +12,8 @@ use serde::Serialize;
 
 use crate::edges;
 use crate::elements::{Elements, Region};
+use crate::geom::raycast::Occluders;
+use crate::indirect;
 use crate::mesh::{self, ReceiverMesh};
 use crate::regions::{self, ReceiverRegions, RegionTimes};
 use crate::vertex_light;
@@ -176,7 +178,21 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
     stats.T_direct = t.elapsed().as_secs_f64();
     [stats.pairs_umbra, stats.pairs_lit, stats.pairs_penumbra] = pairs;
 
-    let radiance = colors(scene, &elements, &direct);
+    let mut irradiance = direct;
+    if scene.settings.indirect {
+        progress.stage("indirect light");
+        let t = Instant::now();
+        let occluders = Occluders::new(&scene.faces);
+        let ind = indirect::indirect(scene, &elements, &irradiance, &occluders, progress)?;
+        stats.T_rs = t.elapsed().as_secs_f64();
+        stats.N_p = ind.patches;
+        stats.shots = ind.shots;
+        stats.unshot_fraction = ind.unshot_fraction;
+        for (e, i) in irradiance.iter_mut().zip(&ind.irradiance) {
+            *e += *i;
+        }
+    }
+    let radiance = colors(scene, &elements, &irradiance);
     let out = output(scene, &elements, &radiance);
     stats.T_total = t_start.elapsed().as_secs_f64();
     Ok(Bake {

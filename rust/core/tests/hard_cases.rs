@@ -9,6 +9,7 @@ fn settings(h: f64) -> SettingsJson {
     SettingsJson {
         element_size: Some(h),
         penumbra_element_size: Some(h / 4.0),
+        indirect: Some(false),
         ..Default::default()
     }
 }

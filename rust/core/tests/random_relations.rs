@@ -105,6 +105,7 @@ fn random_scene(seed: u64) -> penumbra::SceneJson {
         penumbra::scene::json::SettingsJson {
             element_size: Some(0.25),
             penumbra_element_size: Some(0.08),
+            indirect: Some(false),
             ..Default::default()
         },
     )

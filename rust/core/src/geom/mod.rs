@@ -7,6 +7,7 @@ pub mod frame;
 pub mod lambert;
 pub mod plane;
 pub mod polygon;
+pub mod raycast;
 
 pub use frame::Frame;
 pub use plane::Plane;

@@ -1,0 +1,537 @@
+//! Visibility between points of the scene: does any face cross a segment or a ray?
+//!
+//! The BVH (obvhs, `f32`) only narrows the search; every decision is an `f64` test of the
+//! segment against the face's own convex polygon. So that `f32` rounding can never drop a
+//! face, the boxes handed to obvhs are padded well beyond it, and coordinates are taken
+//! relative to the scene's centre before they are rounded.
+//!
+//! Faces are the BVH primitives as they are (convex and planar), not triangles: the `f64`
+//! test against a convex polygon is as cheap as against a triangle, and there are no
+//! internal diagonals along which a ray could slip through between two triangles.
+//!
+//! # Precision
+//! A face blocks only where the segment crosses its plane with both ends more than the
+//! tolerance ([`Occluders::tolerance`], 1e-9 of the scene size) off that plane. So points
+//! lying on a surface (element vertices, samples on a patch) never hit their own face or a
+//! face they touch, and a segment grazing along a face does not count as blocked. The
+//! polygon is grown by the same tolerance, so a ray through the shared edge of two faces is
+//! blocked by at least one of them.
+
+use std::time::Duration;
+
+use glam::{DVec3, Vec3A};
+use obvhs::aabb::Aabb;
+use obvhs::bvh2::builder::build_bvh2;
+use obvhs::bvh2::Bvh2;
+use obvhs::ray::Ray;
+use obvhs::BvhBuildParams;
+
+use crate::geom::Plane;
+use crate::scene::Face;
+
+/// One face as the ray tests need it.
+#[derive(Debug, Clone)]
+struct Occluder {
+    plane: Plane,
+    verts: Vec<DVec3>,
+    /// Per edge: unit in-plane normal pointing inwards, and its offset (inside: `m·p ≥ c`).
+    edges: Vec<(DVec3, f64)>,
+    lo: DVec3,
+    hi: DVec3,
+}
+
+/// All faces of a scene, for visibility queries. Immutable after `new`, so `&self` queries are
+/// safe from any number of threads.
+pub struct Occluders {
+    faces: Vec<Occluder>,
+    bvh: Option<Bvh2>,
+    boxes: Vec<Aabb>,
+    /// The scene's bounds grown by `pad`: queries are cut to it before going to `f32`.
+    lo: DVec3,
+    hi: DVec3,
+    centre: DVec3,
+    /// Padding of the `f32` boxes, in scene units.
+    pad: f64,
+    tol: f64,
+}
+
+impl Occluders {
+    /// Indexes `faces` (face ids in queries are indices into this slice). Faces with fewer
+    /// than 3 vertices or no normal are kept as ids but never block.
+    pub fn new(faces: &[Face]) -> Self {
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        for v in faces.iter().flat_map(|f| f.verts.iter()) {
+            lo = lo.min(*v);
+            hi = hi.max(*v);
+        }
+        let (centre, size, max_abs) = if lo.x <= hi.x {
+            (
+                (lo + hi) * 0.5,
+                (hi - lo).length(),
+                lo.abs().max(hi.abs()).max_element(),
+            )
+        } else {
+            (DVec3::ZERO, 1.0, 1.0)
+        };
+        let size = if size > 0.0 { size } else { max_abs.max(1.0) };
+        // Points computed on a face are off its plane by rounding, ~1e-16 of their
+        // coordinates; 1e-9 of the scene leaves a wide margin yet is far below any feature
+        // the mesher keeps.
+        let tol = 1e-9 * size + 1e-13 * max_abs;
+        // f32 coordinates relative to the centre are off by ~6e-8 of the scene size, and a
+        // rounded direction drifts by ~1e-7 of the length; 1e-5 covers both many times.
+        let pad = 1e-5 * size;
+
+        let occluders: Vec<Occluder> = faces.iter().map(|f| occluder(f, tol)).collect();
+        let boxes: Vec<Aabb> = occluders
+            .iter()
+            .map(|o| {
+                if o.edges.is_empty() {
+                    // Never blocks; a far-away point box keeps the BVH well formed.
+                    let p = Vec3A::splat(f32::MAX / 4.0);
+                    Aabb::new(p, p)
+                } else {
+                    Aabb::new(to_f32(o.lo - centre - pad), to_f32(o.hi - centre + pad))
+                }
+            })
+            .collect();
+        let bvh = if boxes.is_empty() {
+            None
+        } else {
+            Some(build_bvh2(
+                &boxes,
+                BvhBuildParams::medium_build(),
+                &mut Duration::default(),
+            ))
+        };
+        let (lo, hi) = if lo.x <= hi.x {
+            (lo - pad, hi + pad)
+        } else {
+            (DVec3::ZERO, DVec3::ZERO)
+        };
+        Occluders {
+            faces: occluders,
+            bvh,
+            boxes,
+            lo,
+            hi,
+            centre,
+            pad,
+            tol,
+        }
+    }
+
+    /// Distance under which a point counts as lying on a face's plane.
+    pub fn tolerance(&self) -> f64 {
+        self.tol
+    }
+
+    pub fn len(&self) -> usize {
+        self.faces.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.faces.is_empty()
+    }
+
+    /// True if a face crosses the open segment `a`–`b`.
+    pub fn segment_blocked(&self, a: DVec3, b: DVec3) -> bool {
+        self.segment_blocked_skip(a, b, &[])
+    }
+
+    /// As [`segment_blocked`](Self::segment_blocked), ignoring the faces in `skip` (say the
+    /// shooter's and the receiver's own faces, which cannot block but cost a test).
+    pub fn segment_blocked_skip(&self, a: DVec3, b: DVec3, skip: &[u32]) -> bool {
+        let Some(bvh) = &self.bvh else { return false };
+        let d = b - a;
+        let len = d.length();
+        if !(len > self.tol) || !len.is_finite() {
+            return false;
+        }
+        let Some(ray) = self.bvh_ray(a, d / len, len) else {
+            return false;
+        };
+        !bvh.ray_traverse_miss(ray, |_, i| {
+            let id = bvh.primitive_indices[i];
+            if !skip.contains(&id) && self.face_crosses_segment(id, a, b) {
+                0.0
+            } else {
+                f32::INFINITY
+            }
+        })
+    }
+
+    /// True if one of `faces` crosses the open segment `a`–`b`: for callers that already
+    /// know the few faces that could be in the way.
+    pub fn segment_blocked_by(&self, a: DVec3, b: DVec3, faces: &[u32]) -> bool {
+        faces.iter().any(|&f| self.face_crosses_segment(f, a, b))
+    }
+
+    /// True if a face crosses the ray from `origin` (excluded) along `dir` to infinity.
+    pub fn ray_blocked(&self, origin: DVec3, dir: DVec3) -> bool {
+        self.ray_blocked_skip(origin, dir, &[])
+    }
+
+    pub fn ray_blocked_skip(&self, origin: DVec3, dir: DVec3, skip: &[u32]) -> bool {
+        let Some(bvh) = &self.bvh else { return false };
+        let len = dir.length();
+        if !(len > 0.0) || !len.is_finite() {
+            return false;
+        }
+        let dir = dir / len;
+        let Some(ray) = self.bvh_ray(origin, dir, f64::INFINITY) else {
+            return false;
+        };
+        !bvh.ray_traverse_miss(ray, |_, i| {
+            let id = bvh.primitive_indices[i];
+            if !skip.contains(&id) && self.face_crosses_ray(id, origin, dir) {
+                0.0
+            } else {
+                f32::INFINITY
+            }
+        })
+    }
+
+    /// Appends to `out` (in no set order) every face that could cross a segment lying inside the box
+    /// `lo`–`hi` and in front of (or on) each of `planes`: those whose box overlaps it and
+    /// which are not wholly behind one of the planes. A face wholly behind a plane can meet
+    /// such a segment only on that plane, which is where its ends are, and ends never block.
+    pub fn candidates(
+        &self,
+        lo: DVec3,
+        hi: DVec3,
+        planes: &[Plane],
+        skip: &[u32],
+        out: &mut Vec<u32>,
+    ) {
+        let Some(bvh) = &self.bvh else { return };
+        let query = Aabb::new(
+            to_f32(lo - self.centre - self.pad),
+            to_f32(hi - self.centre + self.pad),
+        );
+        bvh.aabb_traverse(query, |bvh, node| {
+            let node = &bvh.nodes[node as usize];
+            for i in node.first_index..node.first_index + node.prim_count {
+                let id = bvh.primitive_indices[i as usize];
+                if !self.boxes[id as usize].intersect_aabb(&query) || skip.contains(&id) {
+                    continue;
+                }
+                let f = &self.faces[id as usize];
+                if f.edges.is_empty() {
+                    continue;
+                }
+                if planes
+                    .iter()
+                    .all(|p| f.verts.iter().any(|v| p.dist(*v) > self.tol))
+                {
+                    out.push(id);
+                }
+            }
+            true
+        });
+    }
+
+    /// The `f32` ray for the part of `o + t·dir`, `t ∈ [0, len]`, inside the scene's bounds:
+    /// cut there, its ends are never far from the centre, so rounding them stays well under
+    /// the padding however far away the query starts. `None` when it misses the scene.
+    fn bvh_ray(&self, o: DVec3, dir: DVec3, len: f64) -> Option<Ray> {
+        let (mut t0, mut t1) = (0.0f64, len);
+        for k in 0..3 {
+            if dir[k] == 0.0 {
+                if o[k] < self.lo[k] || o[k] > self.hi[k] {
+                    return None;
+                }
+                continue;
+            }
+            let (a, b) = ((self.lo[k] - o[k]) / dir[k], (self.hi[k] - o[k]) / dir[k]);
+            t0 = t0.max(a.min(b));
+            t1 = t1.min(a.max(b));
+        }
+        if !(t0 <= t1) {
+            return None;
+        }
+        let start = o + dir * t0;
+        Some(Ray::new(
+            to_f32(start - self.centre),
+            to_f32(dir),
+            0.0,
+            (t1 - t0 + 2.0 * self.pad) as f32,
+        ))
+    }
+
+    /// Whether face `id`'s bounds overlap the box `lo`–`hi` (both grown by the padding):
+    /// narrows a list from [`candidates`](Self::candidates) down to a smaller box.
+    pub fn box_overlaps(&self, id: u32, lo: DVec3, hi: DVec3) -> bool {
+        let f = &self.faces[id as usize];
+        (f.lo - self.pad).cmple(hi + self.pad).all() && (f.hi + self.pad).cmpge(lo - self.pad).all()
+    }
+
+    fn face_crosses_segment(&self, id: u32, a: DVec3, b: DVec3) -> bool {
+        let f = &self.faces[id as usize];
+        if f.edges.is_empty() {
+            return false;
+        }
+        let da = f.plane.dist(a);
+        let db = f.plane.dist(b);
+        let crosses = (da > self.tol && db < -self.tol) || (da < -self.tol && db > self.tol);
+        crosses && f.contains(a + (b - a) * (da / (da - db)), self.tol)
+    }
+
+    fn face_crosses_ray(&self, id: u32, o: DVec3, dir: DVec3) -> bool {
+        let f = &self.faces[id as usize];
+        if f.edges.is_empty() {
+            return false;
+        }
+        let d0 = f.plane.dist(o);
+        let dn = f.plane.n.dot(dir);
+        let crosses = (d0 > self.tol && dn < 0.0) || (d0 < -self.tol && dn > 0.0);
+        crosses && f.contains(o - dir * (d0 / dn), self.tol)
+    }
+}
+
+impl Occluder {
+    /// `p` (on the plane) inside the polygon grown by `tol`.
+    #[inline]
+    fn contains(&self, p: DVec3, tol: f64) -> bool {
+        self.edges.iter().all(|(m, c)| m.dot(p) - c >= -tol)
+    }
+}
+
+fn occluder(f: &Face, tol: f64) -> Occluder {
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    for v in &f.verts {
+        lo = lo.min(*v);
+        hi = hi.max(*v);
+    }
+    let n = f.plane.n;
+    let mut edges = Vec::with_capacity(f.verts.len());
+    let k = f.verts.len();
+    if k >= 3 && n.is_finite() && n.length_squared() > 0.5 {
+        for i in 0..k {
+            let e = f.verts[(i + 1) % k] - f.verts[i];
+            let m = n.cross(e);
+            let l = m.length();
+            // Repeated vertices give zero-length edges, which bound nothing.
+            if l > tol {
+                let m = m / l;
+                edges.push((m, m.dot(f.verts[i])));
+            }
+        }
+        if edges.len() < 3 {
+            edges.clear();
+        }
+    }
+    Occluder {
+        plane: f.plane,
+        verts: f.verts.clone(),
+        edges,
+        lo,
+        hi,
+    }
+}
+
+#[inline]
+fn to_f32(v: DVec3) -> Vec3A {
+    Vec3A::new(v.x as f32, v.y as f32, v.z as f32)
+}
+
+#[cfg(test)]
+pub(crate) mod test {
+    use super::*;
+    use crate::geom::polygon::signed_area_2d;
+    use crate::geom::Frame;
+
+    /// A face from counter-clockwise (seen from the front) vertices.
+    pub(crate) fn face(verts: &[DVec3], albedo: DVec3, emission: DVec3) -> Face {
+        let plane = Plane::from_polygon(verts).expect("face has area");
+        let verts: Vec<DVec3> = verts
+            .iter()
+            .map(|v| *v - plane.n * plane.dist(*v))
+            .collect();
+        let frame = Frame::on_plane(&plane, verts[0]);
+        let poly2: Vec<_> = verts.iter().map(|v| frame.to_2d(*v)).collect();
+        let area = signed_area_2d(&poly2);
+        Face {
+            mesh: 0,
+            source_polygon: 0,
+            verts,
+            plane,
+            frame,
+            poly2,
+            albedo,
+            emission,
+            area,
+        }
+    }
+
+    fn quad(c: DVec3, u: DVec3, v: DVec3) -> Face {
+        face(
+            &[c - u - v, c + u - v, c + u + v, c - u + v],
+            DVec3::splat(0.5),
+            DVec3::ZERO,
+        )
+    }
+
+    fn v(x: f64, y: f64, z: f64) -> DVec3 {
+        DVec3::new(x, y, z)
+    }
+
+    /// A unit square at z = 0 (facing up) and a wall at x = 2 (facing -x).
+    fn two() -> Occluders {
+        Occluders::new(&[
+            quad(v(0., 0., 0.), v(0.5, 0., 0.), v(0., 0.5, 0.)),
+            quad(v(2., 0., 0.), v(0., 0., 1.), v(0., 1., 0.)),
+        ])
+    }
+
+    #[test]
+    fn hit_and_miss() {
+        let o = two();
+        assert!(o.segment_blocked(v(0.1, 0.2, 1.0), v(0.1, 0.2, -1.0)));
+        assert!(o.segment_blocked(v(0.1, 0.2, -1.0), v(0.3, -0.2, 1.0)));
+        assert!(!o.segment_blocked(v(0.6, 0.0, 1.0), v(0.6, 0.0, -1.0)));
+        // Stops short of the square.
+        assert!(!o.segment_blocked(v(0.1, 0.2, 1.0), v(0.1, 0.2, 0.001)));
+        assert!(o.ray_blocked(v(0.1, 0.2, 1.0), v(0.0, 0.0, -3.0)));
+        assert!(!o.ray_blocked(v(0.1, 0.2, 1.0), v(0.0, 0.0, 1.0)));
+        assert!(o.ray_blocked(v(0.0, 0.0, 0.5), v(1.0, 0.0, 0.0)));
+        assert!(!o.ray_blocked(v(0.0, 0.0, 1.5), v(1.0, 0.0, 0.0)));
+        assert!(o.segment_blocked_skip(v(1.0, 0.0, 0.5), v(3.0, 0.1, 0.5), &[0]));
+        assert!(!o.segment_blocked_skip(v(1.0, 0.0, 0.5), v(3.0, 0.1, 0.5), &[1]));
+    }
+
+    #[test]
+    fn edges_block_and_just_outside_does_not() {
+        let o = two();
+        // Through the square's edge x = 0.5 and its corner: the closed polygon blocks.
+        assert!(o.segment_blocked(v(0.5, 0.1, 1.0), v(0.5, 0.1, -1.0)));
+        assert!(o.segment_blocked(v(0.5, 0.5, 1.0), v(0.5, 0.5, -1.0)));
+        assert!(!o.segment_blocked(v(0.5 + 1e-6, 0.1, 1.0), v(0.5 + 1e-6, 0.1, -1.0)));
+        // Slanted through the edge.
+        assert!(o.segment_blocked(v(0.4, 0.1, 1.0), v(0.6, 0.1, -1.0)));
+    }
+
+    #[test]
+    fn endpoints_on_surfaces_do_not_self_hit() {
+        let o = two();
+        // From a point on the square to a point on the wall: both ends lie on faces.
+        assert!(!o.segment_blocked(v(0.3, 0.3, 0.0), v(2.0, 0.2, 0.5)));
+        // Ending exactly on the square, from above and below.
+        assert!(!o.segment_blocked(v(0.1, 0.1, 1.0), v(0.2, 0.2, 0.0)));
+        assert!(!o.segment_blocked(v(0.1, 0.1, -1.0), v(0.2, 0.2, 0.0)));
+        // Leaving the square's surface into its back: still not a hit.
+        assert!(!o.ray_blocked(v(0.2, 0.2, 0.0), v(0.0, 0.0, -1.0)));
+        // Starting on the wall going back through nothing, and through the square.
+        assert!(!o.ray_blocked(v(2.0, 0.0, 0.5), v(1.0, 0.0, 0.0)));
+        assert!(o.ray_blocked(v(2.0, 0.0, 0.5), v(-2.0, 0.0, -0.55)));
+    }
+
+    #[test]
+    fn grazing_along_a_face_is_not_blocked() {
+        let o = two();
+        // In the square's plane, over the square.
+        assert!(!o.segment_blocked(v(-1.0, 0.0, 0.0), v(1.0, 0.1, 0.0)));
+        // Nearly parallel, crossing the plane inside the square: blocked.
+        assert!(o.segment_blocked(v(-1.0, 0.0, 1e-3), v(1.0, 0.0, -1e-3)));
+        // Nearly parallel, crossing the plane outside it.
+        assert!(!o.segment_blocked(v(-1.0, 0.0, 1e-3), v(-0.6, 0.0, -1e-3)));
+    }
+
+    #[test]
+    fn shared_edge_is_watertight() {
+        // Two triangles splitting a square along its diagonal; rays along the diagonal.
+        let a = face(
+            &[v(0., 0., 0.), v(1., 0., 0.), v(1., 1., 0.)],
+            DVec3::ONE,
+            DVec3::ZERO,
+        );
+        let b = face(
+            &[v(0., 0., 0.), v(1., 1., 0.), v(0., 1., 0.)],
+            DVec3::ONE,
+            DVec3::ZERO,
+        );
+        let o = Occluders::new(&[a, b]);
+        for i in 0..=100 {
+            let t = i as f64 / 100.0;
+            assert!(o.segment_blocked(v(t, t, 1.0), v(t, t, -1.0)), "{t}");
+        }
+    }
+
+    #[test]
+    fn far_from_origin_and_tiny() {
+        // A 1 mm square 10 km away: f32 rounding is 1 mm there, yet the f64 tests decide.
+        let c = v(1e4, -1e4, 3e3);
+        let o = Occluders::new(&[quad(c, v(5e-4, 0., 0.), v(0., 5e-4, 0.))]);
+        assert!(o.segment_blocked(c + v(4e-4, 0.0, 1e-3), c + v(4e-4, 0.0, -1e-3)));
+        assert!(!o.segment_blocked(c + v(6e-4, 0.0, 1e-3), c + v(6e-4, 0.0, -1e-3)));
+        assert!(o.ray_blocked(c + v(0.0, 0.0, 1.0), v(1e-4, 0.0, -1.0)));
+        assert!(!o.ray_blocked(c + v(0.0, 0.0, 1.0), v(1e-3, 0.0, -1.0)));
+        // Queries from far outside the (1 mm) scene are cut to it before rounding.
+        assert!(o.segment_blocked(c + v(4e-4, 0.0, 1e3), c + v(4e-4, 0.0, -1e3)));
+        assert!(!o.segment_blocked(c + v(5.1e-4, 0.0, 1e3), c + v(5.1e-4, 0.0, -1e3)));
+        assert!(o.ray_blocked(c + v(4.9e-4, 4.9e-4, 1e3), v(0.0, 0.0, -1.0)));
+    }
+
+    #[test]
+    fn many_faces_agree_with_brute_force() {
+        // A grid of small tilted quads, and seeded random segments.
+        let mut faces = Vec::new();
+        for i in 0..8 {
+            for j in 0..8 {
+                let c = v(i as f64, j as f64, ((i * 7 + j * 3) % 5) as f64 * 0.3);
+                faces.push(quad(c, v(0.4, 0.0, 0.1), v(0.0, 0.35, -0.05)));
+            }
+        }
+        let o = Occluders::new(&faces);
+        let mut s = 0x2545f4914f6cdd1du64;
+        let mut rnd = || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut hits = 0;
+        for _ in 0..2000 {
+            let a = v(rnd() * 9.0 - 1.0, rnd() * 9.0 - 1.0, rnd() * 4.0 - 1.5);
+            let b = v(rnd() * 9.0 - 1.0, rnd() * 9.0 - 1.0, rnd() * 4.0 - 1.5);
+            let brute = (0..faces.len() as u32).any(|f| o.face_crosses_segment(f, a, b));
+            assert_eq!(o.segment_blocked(a, b), brute);
+            hits += brute as u32;
+            let mut cand = Vec::new();
+            o.candidates(a.min(b), a.max(b), &[], &[], &mut cand);
+            assert_eq!(o.segment_blocked_by(a, b, &cand), brute);
+        }
+        assert!(hits > 200 && hits < 1800, "{hits}");
+    }
+
+    #[test]
+    fn candidates_drop_faces_behind_a_plane() {
+        let o = two();
+        let mut out = Vec::new();
+        o.candidates(v(-1., -1., -1.), v(3., 1., 1.), &[], &[], &mut out);
+        out.sort_unstable();
+        assert_eq!(out, vec![0, 1]);
+        out.clear();
+        // Segments in front of the plane x = 1 (facing +x) can only meet the wall.
+        o.candidates(
+            v(-1., -1., -1.),
+            v(3., 1., 1.),
+            &[Plane::new(DVec3::X, 1.0)],
+            &[],
+            &mut out,
+        );
+        assert_eq!(out, vec![1]);
+        out.clear();
+        o.candidates(v(-1., -1., -1.), v(3., 1., 1.), &[], &[1], &mut out);
+        assert_eq!(out, vec![0]);
+    }
+
+    #[test]
+    fn empty_scene_blocks_nothing() {
+        let o = Occluders::new(&[]);
+        assert!(!o.segment_blocked(DVec3::ZERO, DVec3::ONE));
+        assert!(!o.ray_blocked(DVec3::ZERO, DVec3::ONE));
+    }
+}
