@@ -32,15 +32,18 @@ class Config:
     def __init__(self, quick: bool):
         self.quick = quick
         # Probe spacing (fraction of the scene diagonal) for the probe lattice Cycles bakes.
-        self.probe_frac = 1 / 10 if quick else 1 / 16
-        self.ref_samples = 128 if quick else 1024
+        self.probe_frac = 1 / 10 if quick else 1 / 14
+        self.ref_samples = 128 if quick else 512
         self.ref_direct_samples = 64 if quick else 256
         self.ladder = [16, 64] if quick else [16, 64, 256, 1024]
         self.bounces = 64
         # Furniture triangles 60 + 12·N for room-N.
-        self.scaling = [78, 160, 245] if quick else [78, 828, 8328]
-        # A scaling bake that runs longer is stopped and reported as over the limit.
-        self.scaling_timeout = 60 if quick else 300
+        self.scaling = [10, 30, 78] if quick else [78, 245, 828, 8328]
+        # A scaling bake that runs longer is stopped and reported as over the limit; the
+        # larger sizes are then not attempted.
+        self.scaling_timeout = 40 if quick else 200
+        # room-78 (1k triangles) takes most of the quick budget: full suite only.
+        self.scenes = SCENES[:4] if quick else SCENES
         self.render_res = 120 if quick else 200
         self.render_samples = 32 if quick else 128
 
@@ -227,6 +230,30 @@ def scaling(exe, work, cfg):
     return rows
 
 
+def profile(exe, work, name):
+    """Top functions of the default bake of `name` under `perf` (when installed)."""
+    import shutil
+
+    if not shutil.which("perf"):
+        return None
+    scene = os.path.join(work, f"{name}-default.scene.json")
+    data = os.path.join(work, "perf.data")
+    log(f"profile {name} with perf")
+    r = subprocess.run(["perf", "record", "-F", "499", "-g", "-o", data, exe, "bake", scene,
+                        "-o", os.path.join(work, "perf.bake.json")], capture_output=True)
+    if r.returncode != 0:
+        return None
+    rep = subprocess.run(["perf", "report", "-i", data, "--no-children", "--sort", "symbol",
+                          "--percent-limit", "2", "--stdio", "-g", "none"],
+                         capture_output=True, text=True).stdout
+    top = []
+    for line in rep.splitlines():
+        parts = line.strip().split(None, 2)
+        if len(parts) == 3 and parts[0].endswith("%") and parts[1] == "[.]":
+            top.append((float(parts[0][:-1]), parts[2].split("  ")[0].strip()))
+    return dict(scene=name, top=top[:10])
+
+
 def render(exe, py, work, cfg):
     name = "cornell"
     sp = os.path.join(work, f"{name}.json")
@@ -249,10 +276,12 @@ def main():
     ap.add_argument("--quick", action="store_true", help="small suite (a few minutes)")
     ap.add_argument("--out", default=os.path.join(ROOT, "bench"))
     ap.add_argument("--work", default=os.path.join(ROOT, "target", "bench-work"))
-    ap.add_argument("--scenes", nargs="*", default=SCENES)
+    ap.add_argument("--scenes", nargs="*", help=f"default: {' '.join(SCENES)} "
+                    "(--quick: the first four)")
     ap.add_argument("--exe", default=os.path.join(ROOT, "target", "release", "penumbra"))
     a = ap.parse_args()
     cfg = Config(a.quick)
+    a.scenes = a.scenes or cfg.scenes
     os.makedirs(a.work, exist_ok=True)
     os.makedirs(a.out, exist_ok=True)
     t0 = time.perf_counter()
@@ -261,6 +290,7 @@ def main():
     for name in a.scenes:
         bench_scene(name, a.exe, sys.executable, a.work, cfg, res["scenes"])
     res["scaling"] = scaling(a.exe, a.work, cfg)
+    res["profile"] = profile(a.exe, a.work, a.scenes[-1])
     if "cornell" in a.scenes:
         res["render"] = render(a.exe, sys.executable, a.work, cfg)
     res["suite_seconds"] = time.perf_counter() - t0

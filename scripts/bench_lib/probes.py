@@ -109,9 +109,11 @@ def total_area(scene: dict) -> float:
 
 
 def buried(scene: dict, probe_mesh, probe_poly, probe_pos) -> np.ndarray:
-    """True for probes covered by a coplanar polygon facing the other way: the floor under a
-    box standing on it, and the box's bottom. Nobody sees those points; a bake value there
-    is arbitrary, so they are left out of the error."""
+    """True for probes nobody can see, whose bake value is arbitrary (left out of the error):
+    * covered by a coplanar polygon facing the other way (the floor under a box standing on
+      it, and the box's bottom);
+    * inside a closed solid (a face of one box inside another it intersects): the ray from
+      just in front of the probe along its normal first meets the back of a face."""
     polys, owner = [], {}
     for mi, m in enumerate(scene["meshes"]):
         pos = np.asarray(m["positions"], dtype=np.float64)
@@ -138,4 +140,23 @@ def buried(scene: dict, probe_mesh, probe_poly, probe_pos) -> np.ndarray:
             # Inside the convex polygon q (counter-clockwise about N[q]) or on its boundary.
             side = np.stack([np.cross(e[k], x - v[k]) @ N[q] for k in range(len(v))], axis=1)
             out[sel[np.all(side >= -tol * diag, axis=1)]] = True
+
+    import bpy  # noqa: F401  (the bpy module brings mathutils)
+    from mathutils import Vector
+    from mathutils.bvhtree import BVHTree
+
+    verts, tris, tri_poly = [], [], []
+    for q, v in enumerate(polys):
+        o = len(verts)
+        verts.extend(v.tolist())
+        for i in range(1, len(v) - 1):
+            tris.append((o, o + i, o + i + 1))
+            tri_poly.append(q)
+    tree = BVHTree.FromPolygons(verts, tris, all_triangles=True)
+    eps = 1e-6 * diag
+    for k in np.nonzero(~out)[0]:
+        n = N[pid[k]]
+        hit, _, ti, _ = tree.ray_cast(Vector(probe_pos[k] + eps * n), Vector(n))
+        if hit is not None and N[tri_poly[ti]] @ n > 0:
+            out[k] = True
     return out

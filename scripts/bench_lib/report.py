@@ -337,6 +337,12 @@ def write(res, out):
                     for t, m, ok in targets(res)]) + "\n")
     L.append("### Findings (derived from the stats of this run)\n")
     L += [f"- {f}" for f in findings(res)]
+    pr = res.get("profile")
+    if pr and pr["top"]:
+        L.append(f"\n`perf record` of the default bake of {pr['scene']} — functions over 2 % "
+                 "of samples (self time):\n")
+        L.append(table(["% samples", "function"],
+                       [[f"{p:.1f}", f"`{s}`"] for p, s in pr["top"]]) + "\n")
     text = "\n".join(L) + "\n"
     for fn in ("results.md", "README-performance.md"):
         with open(os.path.join(out, fn), "w") as f:
