@@ -25,8 +25,9 @@ def errors(x: np.ndarray, ref: np.ndarray, noise: np.ndarray):
     mean = float(ref.mean())
     mse = max(float(d2.mean() - n2.mean()), 0.0)
     per = np.maximum(d2.mean(1) - n2.mean(1), 0.0)
+    worst = int(np.nonzero(ok)[0][np.argmax(per)])
     return dict(rel_rms=np.sqrt(mse) / mean, rel_max=float(np.sqrt(per.max())) / mean,
-                missing=int((~ok).sum()))
+                missing=int((~ok).sum()), worst=worst)
 
 
 def noise_rel_rms(ref: np.ndarray, noise: np.ndarray) -> float:

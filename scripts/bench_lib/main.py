@@ -183,10 +183,15 @@ def bench_scene(name, exe, py, work, cfg, out):
             log(f"  direct only: {label} {vis}")
             rec, bake = penumbra_job.run_cli(exe, scene, work, f"{name}-d-{label}-{vis}", s)
             x = penumbra_job.colors_at(bake, pm, pp, px)
+            er = errors.errors(x, *refs["direct"])
+            w = er["worst"]
+            er["worst"] = dict(mesh=scene["meshes"][int(pm[w])]["name"], polygon=int(pp[w]),
+                               position=px[w].tolist(), reference=refs["direct"][0][w].tolist(),
+                               ours=x[w].tolist())
             drows.append(dict(method=f"discontinuity {label}, {vis}", kind="discontinuity",
                               level=label, visibility=vis, wall=rec["wall"],
                               peak_mb=rec["peak_mb"], elements=rec["stats"]["N_e"],
-                              stats=rec["stats"], **errors.errors(x, *refs["direct"])))
+                              stats=rec["stats"], **er))
             if vis == "exact":
                 rec, bake = matched_uniform(exe, scene, work, f"{name}-d-{label}",
                                             rec["stats"]["N_e"], area, nodirect)
@@ -278,8 +283,14 @@ def main():
     ap.add_argument("--work", default=os.path.join(ROOT, "target", "bench-work"))
     ap.add_argument("--scenes", nargs="*", help=f"default: {' '.join(SCENES)} "
                     "(--quick: the first four)")
+    ap.add_argument("--report-only", action="store_true",
+                    help="rewrite the markdown and plots from OUT/results.json")
     ap.add_argument("--exe", default=os.path.join(ROOT, "target", "release", "penumbra"))
     a = ap.parse_args()
+    if a.report_only:
+        with open(os.path.join(a.out, "results.json")) as f:
+            print(report.write(json.load(f), a.out))
+        return
     cfg = Config(a.quick)
     a.scenes = a.scenes or cfg.scenes
     os.makedirs(a.work, exist_ok=True)
