@@ -1,0 +1,233 @@
+"""Scene JSON and bake JSON as bpy objects (imported only inside Blender-side processes).
+
+* `cycles_scene`: the scene for Cycles. Each scene mesh becomes one object whose polygons
+  are the probe lattices (same geometry, more vertices), with a Diffuse BSDF of the
+  polygon's albedo (plus an Emission of its emission radiance). Rectangular light polygons
+  become RECTANGLE area lights of power P = L·π·A (Blender's convention L = P/(π·A), see
+  addon/penumbra/cycles_lights.py); other polygons become one-sided emissive faces.
+* `baked_scene`: a bake JSON as meshes with an emission shader reading the colour
+  attribute, for rendering what Penumbra baked.
+"""
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+
+
+def reset(samples: int, seed: int, adaptive: bool, bounces: int, threads: int):
+    import bpy
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    sc = bpy.context.scene
+    sc.render.engine = "CYCLES"
+    cy = sc.cycles
+    cy.device = "CPU"
+    cy.samples = samples
+    cy.seed = seed
+    cy.use_adaptive_sampling = adaptive
+    cy.use_denoising = False
+    cy.sample_clamp_direct = 0.0
+    cy.sample_clamp_indirect = 0.0
+    cy.max_bounces = bounces
+    cy.diffuse_bounces = bounces
+    sc.world = None
+    sc.render.threads_mode = "FIXED"
+    sc.render.threads = threads
+    return sc
+
+
+def _material(name, albedo, emission):
+    import bpy
+
+    mat = bpy.data.materials.new(name)
+    nt = mat.node_tree
+    nt.nodes.clear()
+    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    bsdf = nt.nodes.new("ShaderNodeBsdfDiffuse")
+    bsdf.inputs["Color"].default_value = (*albedo, 1.0)
+    bsdf.inputs["Roughness"].default_value = 0.0
+    shader = bsdf.outputs["BSDF"]
+    if emission is not None and max(emission) > 0:
+        em = nt.nodes.new("ShaderNodeEmission")
+        em.inputs["Color"].default_value = (*emission, 1.0)
+        em.inputs["Strength"].default_value = 1.0
+        add = nt.nodes.new("ShaderNodeAddShader")
+        nt.links.new(shader, add.inputs[0])
+        nt.links.new(em.outputs["Emission"], add.inputs[1])
+        shader = add.outputs["Shader"]
+    nt.links.new(shader, out.inputs["Surface"])
+    return mat
+
+
+def _per_polygon(v, n):
+    if v is None:
+        return [None] * n
+    a = np.asarray(v, dtype=np.float64)
+    if a.ndim == 1:
+        return [tuple(a)] * n
+    return [tuple(x) for x in a]
+
+
+def _object(name, verts, tris, material_index=None, materials=()):
+    import bpy
+
+    me = bpy.data.meshes.new(name)
+    me.from_pydata(np.asarray(verts).tolist(), [], np.asarray(tris).tolist())
+    for m in materials:
+        me.materials.append(m)
+    if material_index is not None:
+        me.polygons.foreach_set("material_index", np.asarray(material_index, dtype=np.int32))
+    me.update()
+    ob = bpy.data.objects.new(name, me)
+    bpy.context.scene.collection.objects.link(ob)
+    return ob
+
+
+def _light(l, index):
+    import bpy
+
+    poly = np.asarray(l["polygon"], dtype=np.float64)
+    L = np.asarray(l["radiance"], dtype=np.float64)
+    n = np.zeros(3)
+    for i in range(len(poly)):
+        n += np.cross(poly[i], poly[(i + 1) % len(poly)])
+    n /= np.linalg.norm(n)
+    c = poly.mean(0)
+    rect = False
+    if len(poly) == 4:
+        e = [poly[(i + 1) % 4] - poly[i] for i in range(4)]
+        rect = all(abs(np.dot(e[i], e[(i + 1) % 4])) < 1e-9 * (1 + np.dot(e[i], e[i]))
+                   for i in range(4))
+    if not rect:
+        # One-sided emissive polygon of radiance L (emission strength 1 = radiance 1).
+        mat = bpy.data.materials.new(f"LightMat{index}")
+        nt = mat.node_tree
+        nt.nodes.clear()
+        out = nt.nodes.new("ShaderNodeOutputMaterial")
+        em = nt.nodes.new("ShaderNodeEmission")
+        em.inputs["Color"].default_value = (*L, 1.0)
+        em.inputs["Strength"].default_value = 1.0
+        # Back faces black: the light emits from its front only.
+        geo = nt.nodes.new("ShaderNodeNewGeometry")
+        mix = nt.nodes.new("ShaderNodeMixShader")
+        tr = nt.nodes.new("ShaderNodeBsdfTransparent")
+        nt.links.new(geo.outputs["Backfacing"], mix.inputs[0])
+        nt.links.new(em.outputs["Emission"], mix.inputs[1])
+        nt.links.new(tr.outputs["BSDF"], mix.inputs[2])
+        nt.links.new(mix.outputs["Shader"], out.inputs["Surface"])
+        return _object(l["name"], poly, [list(range(len(poly)))], materials=[mat])
+    u, w = poly[1] - poly[0], poly[3] - poly[0]
+    zax = -n                        # an area light emits along its −Z
+    xax = u / np.linalg.norm(u)
+    yax = np.cross(zax, xax)
+    area = np.linalg.norm(u) * np.linalg.norm(w)
+    P = L * math.pi * area
+    data = bpy.data.lights.new(l["name"], "AREA")
+    data.shape = "RECTANGLE"
+    data.size = float(np.linalg.norm(u))
+    data.size_y = float(np.linalg.norm(w))
+    data.energy = float(P.max())
+    data.color = tuple(P / P.max()) if P.max() > 0 else (1, 1, 1)
+    ob = bpy.data.objects.new(l["name"], data)
+    m = np.eye(4)
+    m[:3, 0], m[:3, 1], m[:3, 2], m[:3, 3] = xax, yax, zax, c
+    import mathutils
+
+    ob.matrix_world = mathutils.Matrix(m.tolist())
+    bpy.context.scene.collection.objects.link(ob)
+    return ob
+
+
+def cycles_scene(scene: dict, lattices: list[dict]):
+    """Builds the Cycles scene; returns the receiver objects (one per scene mesh)."""
+    objs = []
+    for m, lat in zip(scene["meshes"], lattices):
+        npoly = len(m["polygons"])
+        alb = _per_polygon(m.get("albedo") or [0.8, 0.8, 0.8], npoly)
+        emi = _per_polygon(m.get("emission"), npoly)
+        keys = {}
+        mats = []
+        pmat = []
+        for a, e in zip(alb, emi):
+            k = (a, e)
+            if k not in keys:
+                keys[k] = len(mats)
+                mats.append(_material(f"{m['name']}.{len(mats)}", a, e))
+            pmat.append(keys[k])
+        tri_poly = lat["polygon"][lat["tris"][:, 0]]
+        objs.append(_object(m["name"], lat["verts"], lat["tris"],
+                            np.asarray(pmat)[tri_poly], mats))
+    for i, l in enumerate(scene["lights"]):
+        if "polygon" in l:
+            _light(l, i)
+        else:
+            raise ValueError(f"bench: light {l['name']!r}: only polygon lights are benchmarked")
+    return objs
+
+
+def baked_scene(bake: dict):
+    """The bake JSON as meshes shaded by an emission of their colour attribute."""
+    import bpy
+
+    mat = bpy.data.materials.new("Baked")
+    nt = mat.node_tree
+    nt.nodes.clear()
+    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    em = nt.nodes.new("ShaderNodeEmission")
+    attr = nt.nodes.new("ShaderNodeAttribute")
+    attr.attribute_name = "Penumbra"
+    nt.links.new(attr.outputs["Color"], em.inputs["Color"])
+    nt.links.new(em.outputs["Emission"], out.inputs["Surface"])
+    for m in bake["meshes"]:
+        if not m["triangles"]:
+            continue
+        ob = _object(m["name"], m["positions"], m["triangles"], materials=[mat])
+        col = np.ones((len(m["positions"]), 4), dtype=np.float32)
+        col[:, :3] = np.asarray(m["colors"], dtype=np.float32)
+        a = ob.data.color_attributes.new("Penumbra", "FLOAT_COLOR", "POINT")
+        a.data.foreach_set("color", col.ravel())
+
+
+def camera(location, target, lens=35.0):
+    import bpy
+    import mathutils
+
+    cam = bpy.data.cameras.new("Camera")
+    cam.lens = lens
+    ob = bpy.data.objects.new("Camera", cam)
+    ob.location = location
+    d = mathutils.Vector(target) - mathutils.Vector(location)
+    ob.rotation_euler = d.to_track_quat("-Z", "Y").to_euler()
+    bpy.context.scene.collection.objects.link(ob)
+    bpy.context.scene.camera = ob
+
+
+def bake_vertex_colors(objs, pass_filter):
+    """One Cycles Diffuse bake of all `objs` into a float vertex attribute; returns the
+    seconds of the bake call and per object the (V,3) colours."""
+    import time
+
+    import bpy
+
+    for o in bpy.context.scene.objects:
+        o.select_set(False)
+    for o in objs:
+        a = o.data.color_attributes.new("CyclesBake", "FLOAT_COLOR", "POINT")
+        o.data.color_attributes.active_color = a
+        o.select_set(True)
+    bpy.context.view_layer.objects.active = objs[0]
+    t = time.perf_counter()
+    res = bpy.ops.object.bake(type="DIFFUSE", pass_filter=set(pass_filter),
+                              target="VERTEX_COLORS", use_clear=True, margin=0)
+    dt = time.perf_counter() - t
+    if res != {"FINISHED"}:
+        raise RuntimeError(f"Cycles bake failed: {res}")
+    cols = []
+    for o in objs:
+        nv = len(o.data.vertices)
+        c = np.empty(nv * 4, dtype=np.float32)
+        o.data.color_attributes["CyclesBake"].data.foreach_get("color", c)
+        cols.append(c.reshape(-1, 4)[:, :3].astype(np.float64))
+    return dt, cols

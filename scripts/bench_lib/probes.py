@@ -1,0 +1,162 @@
+"""Probe points on the receivers: every polygon of every scene mesh is fanned into
+triangles and each triangle is split into a lattice of spacing about `spacing`. The
+lattice vertices strictly inside the polygon are the probes (the boundary is left out: a
+vertex there is shared by faces meeting at a crease, where a bake value is ambiguous).
+
+The same lattice, as a mesh, is what Cycles bakes vertex colours on: it has the scene's
+exact geometry, only more vertices.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def polygon_lattice(poly: np.ndarray, spacing: float):
+    """Lattice of one convex polygon (k, 3) → (vertices (V,3), triangles (T,3), interior mask)."""
+    k = len(poly)
+    c = poly.mean(0)
+    if np.max(np.linalg.norm(poly - c, axis=1)) < 0.5 * spacing:
+        # Smaller than one lattice cell: one probe at the centre, fanned to the corners.
+        tris = np.array([(i, (i + 1) % k, k) for i in range(k)], dtype=np.int64)
+        return np.vstack([poly, c]), tris, np.r_[np.zeros(k, bool), True]
+    verts: list[np.ndarray] = []
+    index: dict[tuple, int] = {}
+    tris: list[tuple[int, int, int]] = []
+    interior: list[bool] = []
+
+    def vid(p: np.ndarray, inside: bool) -> int:
+        key = tuple(np.round(p, 9))
+        i = index.get(key)
+        if i is None:
+            i = len(verts)
+            index[key] = i
+            verts.append(p)
+            interior.append(inside)
+        else:
+            interior[i] = interior[i] and inside
+        return i
+
+    for t in range(1, k - 1):
+        a, b, c = poly[0], poly[t], poly[t + 1]
+        longest = max(np.linalg.norm(b - a), np.linalg.norm(c - b), np.linalg.norm(a - c))
+        m = max(3, math.ceil(longest / spacing))
+        ids = {}
+        for i in range(m + 1):
+            for j in range(m + 1 - i):
+                l = m - i - j
+                p = (i * a + j * b + l * c) / m
+                # On the polygon's boundary: b-c (i = 0) always, a-b (l = 0) only in the
+                # first fan triangle, c-a (j = 0) only in the last; fan diagonals are inside.
+                on = (i == 0) or (l == 0 and t == 1) or (j == 0 and t == k - 2)
+                ids[i, j] = vid(p, not on)
+        for i in range(m):
+            for j in range(m - i):
+                tris.append((ids[i, j], ids[i + 1, j], ids[i, j + 1]))
+                if i + j + 1 < m:
+                    tris.append((ids[i + 1, j], ids[i + 1, j + 1], ids[i, j + 1]))
+    return np.array(verts), np.array(tris, dtype=np.int64), np.array(interior, dtype=bool)
+
+
+def scene_probes(scene: dict, spacing: float):
+    """Per mesh: lattice vertices, triangles, and per vertex (polygon index, is-probe).
+
+    Returns a list of dicts {name, verts, tris, polygon, probe} and the probes gathered as
+    arrays (mesh index, polygon index, position)."""
+    meshes = []
+    pm, pp, px = [], [], []
+    for mi, m in enumerate(scene["meshes"]):
+        pos = np.asarray(m["positions"], dtype=np.float64)
+        V, T, P, I = [], [], [], []
+        off = 0
+        for pi, poly in enumerate(m["polygons"]):
+            v, t, inside = polygon_lattice(pos[poly], spacing)
+            V.append(v)
+            T.append(t + off)
+            P.append(np.full(len(v), pi))
+            I.append(inside)
+            off += len(v)
+        verts, polys, inside = np.concatenate(V), np.concatenate(P), np.concatenate(I)
+        meshes.append(dict(name=m["name"], verts=verts, tris=np.concatenate(T),
+                           polygon=polys, probe=inside))
+        pm.append(np.full(inside.sum(), mi))
+        pp.append(polys[inside])
+        px.append(verts[inside])
+    return meshes, (np.concatenate(pm), np.concatenate(pp), np.concatenate(px))
+
+
+def scene_diagonal(scene: dict) -> float:
+    """Bounding-box diagonal of meshes and lights, as the core computes it for defaults."""
+    pts = [np.asarray(m["positions"], dtype=np.float64) for m in scene["meshes"]]
+    for l in scene["lights"]:
+        if "polygon" in l:
+            pts.append(np.asarray(l["polygon"], dtype=np.float64))
+        elif "point" in l:
+            pts.append(np.asarray([l["point"]], dtype=np.float64))
+    p = np.concatenate(pts)
+    return float(np.linalg.norm(p.max(0) - p.min(0)))
+
+
+def total_area(scene: dict) -> float:
+    a = 0.0
+    for m in scene["meshes"]:
+        pos = np.asarray(m["positions"], dtype=np.float64)
+        for poly in m["polygons"]:
+            v = pos[poly]
+            a += 0.5 * np.linalg.norm(np.cross(v[1:-1] - v[0], v[2:] - v[0]).sum(0))
+    return a
+
+
+def buried(scene: dict, probe_mesh, probe_poly, probe_pos) -> np.ndarray:
+    """True for probes nobody can see, whose bake value is arbitrary (left out of the error):
+    * covered by a coplanar polygon facing the other way (the floor under a box standing on
+      it, and the box's bottom);
+    * inside a closed solid (a face of one box inside another it intersects): the ray from
+      just in front of the probe along its normal first meets the back of a face."""
+    polys, owner = [], {}
+    for mi, m in enumerate(scene["meshes"]):
+        pos = np.asarray(m["positions"], dtype=np.float64)
+        for pi, poly in enumerate(m["polygons"]):
+            owner[mi, pi] = len(polys)
+            polys.append(pos[poly])
+    N = np.array([np.cross(p[1:-1] - p[0], p[2:] - p[0]).sum(0) for p in polys])
+    N /= np.linalg.norm(N, axis=1, keepdims=True)
+    D = np.array([n @ p[0] for n, p in zip(N, polys)])
+    diag = scene_diagonal(scene)
+    tol = 1e-7 * diag
+    out = np.zeros(len(probe_pos), dtype=bool)
+    pid = np.array([owner[int(a), int(b)] for a, b in zip(probe_mesh, probe_poly)])
+    opposite = (N @ N.T) < -0.999
+    for p in np.unique(pid):
+        cands = np.nonzero(opposite[p] & (np.abs(D + D[p]) < tol))[0]
+        if len(cands) == 0:
+            continue
+        sel = np.nonzero(pid == p)[0]
+        x = probe_pos[sel]
+        for q in cands:
+            v = polys[q]
+            e = np.roll(v, -1, axis=0) - v
+            # Inside the convex polygon q (counter-clockwise about N[q]) or on its boundary.
+            side = np.stack([np.cross(e[k], x - v[k]) @ N[q] for k in range(len(v))], axis=1)
+            out[sel[np.all(side >= -tol * diag, axis=1)]] = True
+
+    import bpy  # noqa: F401  (the bpy module brings mathutils)
+    from mathutils import Vector
+    from mathutils.bvhtree import BVHTree
+
+    verts, tris, tri_poly = [], [], []
+    for q, v in enumerate(polys):
+        o = len(verts)
+        verts.extend(v.tolist())
+        for i in range(1, len(v) - 1):
+            tris.append((o, o + i, o + i + 1))
+            tri_poly.append(q)
+    tree = BVHTree.FromPolygons(verts, tris, all_triangles=True)
+    eps = 1e-6 * diag
+    for k in np.nonzero(~out)[0]:
+        n = N[pid[k]]
+        hit, _, ti, _ = tree.ray_cast(Vector(probe_pos[k] + eps * n), Vector(n))
+        if hit is not None and N[tri_poly[ti]] @ n > 0:
+            out[k] = True
+    return out
