@@ -1,5 +1,5 @@
 """The benchmark suite behind `scripts/bench`. Writes bench/results.json, bench/results.md,
-bench/README-performance.md and bench/*.png, and prints the tables.
+bench/*.png and the README's Performance section, and prints the tables.
 
 Every figure in the outputs comes from this run; nothing is typed in except the paper's
 published numbers (PAPER.md), which are labelled as such.
