@@ -140,6 +140,9 @@ def plots(res, out):
         files["render"] = "render_cornell.png"
         fig.savefig(os.path.join(out, files["render"]), dpi=110)
         plt.close(fig)
+    elif rd and os.path.exists(os.path.join(out, "render_cornell.png")):
+        # --report-only after the work directory is gone: the composite of that run stays.
+        files["render"] = "render_cornell.png"
     return files
 
 
