@@ -115,6 +115,15 @@ fn has_emission(s: &SceneJson) -> bool {
     })
 }
 
+/// A number as a person would write it in a message: 1e30, not thirty-one digits.
+fn num(x: f64) -> String {
+    if x != 0.0 && x.is_finite() && !(1e-4..1e6).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
 fn check_point(obj: &str, field: &str, p: [f64; 3]) -> Result<DVec3, BakeError> {
     for (k, &x) in p.iter().enumerate() {
         if !x.is_finite() {
@@ -128,7 +137,7 @@ fn check_point(obj: &str, field: &str, p: [f64; 3]) -> Result<DVec3, BakeError> 
             return Err(BakeError::invalid(
                 obj,
                 field,
-                format!("coordinate {k} = {x} is beyond ±{MAX_COORD:e}"),
+                format!("coordinate {k} = {} is beyond ±{MAX_COORD:e}", num(x)),
             ));
         }
     }
@@ -141,7 +150,7 @@ fn check_color(obj: &str, field: &str, c: [f64; 3], max: f64) -> Result<DVec3, B
             return Err(BakeError::invalid(
                 obj,
                 field,
-                format!("channel {k} is {x}, must be in [0, {max}]"),
+                format!("channel {k} is {}, must be in [0, {}]", num(x), num(max)),
             ));
         }
     }
