@@ -164,7 +164,7 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
         .zip(&shadows)
         .map(|(rr, sh)| {
             progress.check()?;
-            mesh::mesh_receiver(rr, sh, &scene.settings, &budget)
+            mesh::mesh_receiver(rr, sh, &scene.settings, diag, &budget)
         })
         .collect::<Result<_, _>>()?;
     let elements = assemble(scene, &meshes);

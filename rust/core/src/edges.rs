@@ -6,6 +6,7 @@
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
+use crate::cuts::{inside_solid, plane_cut};
 use crate::events::critical_segments;
 use crate::geom::bvh::{Aabb, BoxTree};
 use crate::geom::polygon::{
@@ -50,6 +51,12 @@ pub struct ReceiverShadows {
     /// Occluder edges lying on the receiver (contact lines), in its frame: light jumps
     /// across them (D0), so the mesh must not share vertices there.
     pub contacts: Vec<[DVec2; 2]>,
+    /// Lines where an occluder face passes through the receiver (`cuts::plane_cut`), in its
+    /// frame: D0 like contacts, and the arrangement must split along them.
+    pub plane_cuts: Vec<[DVec2; 2]>,
+    /// The parts of the receiver inside closed solids (convex, counter-clockwise, in its
+    /// frame): no light reaches them.
+    pub inside: Vec<Vec<DVec2>>,
     /// VE/EV critical lines inside penumbrae (light index, segment), see `events`.
     pub events: Vec<(u32, [DVec2; 2])>,
 }
@@ -179,6 +186,8 @@ pub fn shadow_polygons(
             exposure: vec![Exposure::Regions; scene.lights.len()],
             polys: Vec::new(),
             contacts: Vec::new(),
+            plane_cuts: Vec::new(),
+            inside: Vec::new(),
             events: Vec::new(),
         })
         .collect();
@@ -242,9 +251,21 @@ pub fn shadow_polygons(
             per_receiver[ri]
                 .events
                 .extend(res.events.into_iter().map(|e| (li as u32, e)));
+            let pr = &mut per_receiver[ri];
             for c in res.contacts {
-                if !per_receiver[ri].contacts.contains(&c) {
-                    per_receiver[ri].contacts.push(c);
+                if !pr.contacts.contains(&c) {
+                    pr.contacts.push(c);
+                }
+            }
+            // Cuts are the same under every light; a light only decides which are found.
+            for c in res.plane_cuts {
+                if !pr.plane_cuts.contains(&c) {
+                    pr.plane_cuts.push(c);
+                }
+            }
+            for p in res.inside {
+                if !pr.inside.contains(&p) {
+                    pr.inside.push(p);
                 }
             }
         }
@@ -258,6 +279,8 @@ struct OnReceiver {
     exposure: Exposure,
     polys: Vec<ShadowPolygon>,
     contacts: Vec<[DVec2; 2]>,
+    plane_cuts: Vec<[DVec2; 2]>,
+    inside: Vec<Vec<DVec2>>,
     events: Vec<[DVec2; 2]>,
 }
 
@@ -267,6 +290,8 @@ impl OnReceiver {
             exposure: Exposure::Hidden,
             polys: Vec::new(),
             contacts: Vec::new(),
+            plane_cuts: Vec::new(),
+            inside: Vec::new(),
             events: Vec::new(),
         }
     }
@@ -288,6 +313,8 @@ fn receiver_polygons(
     };
     let mut out = Vec::new();
     let mut contacts = Vec::new();
+    let mut plane_cuts = Vec::new();
+    let mut inside = Vec::new();
     let mut events = Vec::new();
     let touch = 1e3 * eps;
     if let LightKind::Area { plane, .. } = kind {
@@ -322,6 +349,17 @@ fn receiver_polygons(
         for [a, b] in edges {
             if r.plane.dist(*a).abs() <= touch && r.plane.dist(*b).abs() <= touch {
                 contacts.push([r.frame.to_2d(*a), r.frame.to_2d(*b)]);
+            }
+        }
+        let occ = &scene.occluders[oi as usize];
+        for &f in occ.faces() {
+            if let Some(c) = plane_cut(&scene.faces[f as usize].verts, r, touch) {
+                plane_cuts.push(c);
+            }
+        }
+        if let Occluder::Solid { solid, .. } = occ {
+            if let Some(p) = inside_solid(solid, r, eps) {
+                inside.push(p);
             }
         }
         let recomputed;
@@ -374,6 +412,8 @@ fn receiver_polygons(
         exposure: Exposure::Regions,
         polys: out,
         contacts,
+        plane_cuts,
+        inside,
         events,
     }
 }

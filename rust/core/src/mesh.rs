@@ -36,11 +36,14 @@ pub struct ReceiverMesh {
 type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
 
 /// Meshes one receiver. `budget` counts vertices over the whole scene so that a bake that
-/// would exceed `max_elements` stops early with a clear error.
+/// would exceed `max_elements` stops early with a clear error. `diag` is the scene's size:
+/// evaluation points on D0 rows move at least 1e-9 of it off the line, so that the exact
+/// side tests of the light stages see them on their own side.
 pub fn mesh_receiver(
     rr: &ReceiverRegions,
     sh: &ReceiverShadows,
     settings: &Settings,
+    diag: f64,
     budget: &AtomicU64,
 ) -> Result<ReceiverMesh, BakeError> {
     let arr = &rr.arrangement;
@@ -107,14 +110,14 @@ pub fn mesh_receiver(
         Ordering::Relaxed,
     );
     if settings.uniform {
-        let mut m = extract(&cdt, sh, true);
+        let mut m = extract(&cdt, sh, true, diag);
         m.regions = vec![rr.faces.first().cloned().unwrap_or(RegionFace {
             relations: Vec::new(),
             blockers: Vec::new(),
         })];
         return Ok(m);
     }
-    Ok(extract(&cdt, sh, false))
+    Ok(extract(&cdt, sh, false, diag))
 }
 
 /// Triangular lattice points strictly inside `f`, at least 0.35·h from its boundary.
@@ -193,7 +196,7 @@ fn seg_dist(a: DVec2, b: DVec2, p: DVec2) -> f64 {
 
 /// Triangles, their regions (connected components across non-constraint edges, classified
 /// once each), and the D0 vertex split.
-fn extract(cdt: &Cdt, sh: &ReceiverShadows, uniform: bool) -> ReceiverMesh {
+fn extract(cdt: &Cdt, sh: &ReceiverShadows, uniform: bool, diag: f64) -> ReceiverMesh {
     let nv = cdt.num_vertices();
     let mut positions: Vec<DVec2> = cdt
         .vertices()
@@ -267,9 +270,12 @@ fn extract(cdt: &Cdt, sh: &ReceiverShadows, uniform: bool) -> ReceiverMesh {
         .iter()
         .fold(0.0f64, |m, p| m.max(p.abs().max_element()))
         .max(1e-300);
+    // Contacts and plane cuts: an occluder meets the receiver there, so light jumps even
+    // where both sides are in penumbra.
     let on_contact = |p: DVec2, q: DVec2| {
         sh.contacts
             .iter()
+            .chain(&sh.plane_cuts)
             .any(|&[a, b]| seg_dist(a, b, p) <= 1e-9 * scale && seg_dist(a, b, q) <= 1e-9 * scale)
     };
     let is_d0_edge = |e: spade::handles::DirectedEdgeHandle<
@@ -327,8 +333,15 @@ fn extract(cdt: &Cdt, sh: &ReceiverShadows, uniform: bool) -> ReceiverMesh {
             if s > 0 && cut(k) && !current.is_empty() {
                 sectors.push(std::mem::take(&mut current));
             }
-            if let Some(f) = out[k].face().as_inner() {
-                current.push(face_index[&f.fix()]);
+            match out[k].face().as_inner() {
+                Some(f) => current.push(face_index[&f.fix()]),
+                // The receiver's boundary ends a sector too: on a boundary vertex the two
+                // sides of a D0 line meet again only across the outside.
+                None => {
+                    if !current.is_empty() {
+                        sectors.push(std::mem::take(&mut current));
+                    }
+                }
             }
         }
         if !current.is_empty() {
@@ -361,7 +374,8 @@ fn extract(cdt: &Cdt, sh: &ReceiverShadows, uniform: bool) -> ReceiverMesh {
                 }
             }
             if dir != DVec2::ZERO && shortest.is_finite() {
-                eval[id as usize] = p + dir.normalize() * (shortest * 1e-6);
+                let step = (shortest * 1e-6).max(1e-9 * diag).min(0.25 * shortest);
+                eval[id as usize] = p + dir.normalize() * step;
             }
             if k > 0 {
                 for &t in sector {

@@ -38,10 +38,12 @@ pub struct ReceiverRegions {
 struct Indexed<'a> {
     polys: &'a [ShadowPolygon],
     boxes: Vec<(DVec2, DVec2)>,
+    /// Parts of the receiver inside closed solids.
+    inside: &'a [Vec<DVec2>],
 }
 
 impl<'a> Indexed<'a> {
-    fn new(polys: &'a [ShadowPolygon]) -> Self {
+    fn new(polys: &'a [ShadowPolygon], inside: &'a [Vec<DVec2>]) -> Self {
         let boxes = polys
             .iter()
             .map(|p| {
@@ -54,7 +56,11 @@ impl<'a> Indexed<'a> {
                 (lo, hi)
             })
             .collect();
-        Indexed { polys, boxes }
+        Indexed {
+            polys,
+            boxes,
+            inside,
+        }
     }
 
     /// Relation and blockers of the point `q` (strictly inside some arrangement face).
@@ -62,6 +68,12 @@ impl<'a> Indexed<'a> {
         let n = exposure.len();
         let mut relations = vec![Relation::Lit; n];
         let mut blockers = vec![Vec::new(); n];
+        if self.inside.iter().any(|p| inside_convex(p, q)) {
+            return RegionFace {
+                relations: vec![Relation::Umbra; n],
+                blockers,
+            };
+        }
         for (l, e) in exposure.iter().enumerate() {
             if *e == Exposure::Hidden {
                 relations[l] = Relation::Umbra;
@@ -107,7 +119,7 @@ impl<'a> Indexed<'a> {
 
 /// Relation of a point to all lights, from the receiver's shadow polygons (exact tests).
 pub fn classify_point(sh: &ReceiverShadows, q: DVec2) -> RegionFace {
-    Indexed::new(&sh.polys).classify(q, &sh.exposure)
+    Indexed::new(&sh.polys, &sh.inside).classify(q, &sh.exposure)
 }
 
 pub struct RegionTimes {
@@ -157,6 +169,14 @@ pub fn build_regions(
             tag: n_polys + k as u32,
         });
     }
+    let n_events = sh.events.len() as u32;
+    for (k, [a, b]) in sh.plane_cuts.iter().enumerate() {
+        segs.push(Segment {
+            a: *a,
+            b: *b,
+            tag: n_polys + n_events + k as u32,
+        });
+    }
     let t_idd = t0.elapsed().as_secs_f64();
     let t1 = std::time::Instant::now();
     let extent = r
@@ -169,7 +189,7 @@ pub fn build_regions(
     let t_lop = t1.elapsed().as_secs_f64();
 
     let t2 = std::time::Instant::now();
-    let index = Indexed::new(&sh.polys);
+    let index = Indexed::new(&sh.polys, &sh.inside);
     let faces: Vec<RegionFace> = arr
         .faces
         .iter()
@@ -190,13 +210,17 @@ pub fn build_regions(
             }
         }
     }
+    // The light an edge belongs to; `None` for a plane cut, which belongs to every light.
     let light_of = |t: u32| {
         if t < n_polys {
-            sh.polys[t as usize].light
+            Some(sh.polys[t as usize].light)
+        } else if t < n_polys + n_events {
+            Some(sh.events[(t - n_polys) as usize].0)
         } else {
-            sh.events[(t - n_polys) as usize].0
+            None
         }
     };
+    let n_lights = sh.exposure.len();
     let mut parent: Vec<u32> = (0..arr.faces.len() as u32).collect();
     let mut kept = Vec::new();
     let mut n_disc = 0u64;
@@ -209,9 +233,14 @@ pub fn build_regions(
         let redundant = a != u32::MAX
             && b != u32::MAX
             && e.tags.iter().all(|&t| {
-                let l = light_of(t) as usize;
-                faces[a as usize].relations[l] == Relation::Umbra
-                    && faces[b as usize].relations[l] == Relation::Umbra
+                let both_umbra = |l: usize| {
+                    faces[a as usize].relations[l] == Relation::Umbra
+                        && faces[b as usize].relations[l] == Relation::Umbra
+                };
+                match light_of(t) {
+                    Some(l) => both_umbra(l as usize),
+                    None => (0..n_lights).all(both_umbra),
+                }
             });
         if redundant {
             union(&mut parent, a, b);

@@ -114,6 +114,16 @@ fn vertex_direct(scene: &Scene, el: &Elements, v: usize, regions: &[u32]) -> (DV
         };
         let mut owned: Vec<Vec<DVec3>> = Vec::new();
         let mut face_refs: Vec<u32> = Vec::new();
+        // A point inside a closed solid (a receiver passing through it) sees no light. The
+        // margin keeps points on a solid's surface (contacts) outside.
+        let margin = 1e-12 * scene.diagonal();
+        let buried = occ.iter().any(|&o| match &scene.occluders[o as usize] {
+            Occluder::Solid { solid, .. } => solid.planes.iter().all(|f| f.dist(p) < -margin),
+            Occluder::Face(_) => false,
+        });
+        if buried {
+            continue;
+        }
         for &o in &occ {
             match &scene.occluders[o as usize] {
                 Occluder::Face(f) => face_refs.push(*f),
@@ -186,6 +196,11 @@ fn solid_outline(p: DVec3, s: &Solid, lplane: &Plane) -> Option<Vec<DVec3>> {
     }
     let front: Vec<bool> = s.planes.iter().map(|f| f.dist(p) > 0.0).collect();
     if !front.iter().any(|&f| f) {
+        return None;
+    }
+    // A solid reaching through the light's plane: only its part in front of the light
+    // blocks, which its outline does not tell.
+    if s.verts.iter().any(|v| !(lplane.dist(*v) > 0.0)) {
         return None;
     }
     let h = 0.5 * dp;
