@@ -107,8 +107,8 @@ mod test {
             DVec2::new(1.0, 1.0),
             DVec2::new(0.0, 1.0),
         ];
-        let s = clip_segment_convex(DVec2::new(-1.0, 0.5), DVec2::new(3.0, 0.5), &sq, 1e-12)
-            .unwrap();
+        let s =
+            clip_segment_convex(DVec2::new(-1.0, 0.5), DVec2::new(3.0, 0.5), &sq, 1e-12).unwrap();
         assert!((s[0] - DVec2::new(0.0, 0.5)).length() < 1e-15);
         assert!((s[1] - DVec2::new(1.0, 0.5)).length() < 1e-15);
         assert!(
