@@ -213,24 +213,36 @@ def bench_scene(name, exe, py, work, cfg, out):
     return res
 
 
+# Scaling series: the full bake (the targets) and direct light only (the
+# discontinuity stages and exact direct light, without the radiosity solve).
+SCALING_MODES = {"full": {}, "direct": {"indirect": False}}
+
+
 def scaling(exe, work, cfg):
     rows = []
+    stopped = set()
     for n in cfg.scaling:
         name = f"room-{n}"
-        log(f"scaling {name}")
         sp = os.path.join(work, f"{name}.json")
         subprocess.run([exe, "scene", name, "-o", sp], check=True)
         scene = json.load(open(sp))
         tris = sum(len(p) - 2 for m in scene["meshes"] for p in m["polygons"])
         furn = sum(len(p) - 2 for m in scene["meshes"] if m["name"] != "Room"
                    for p in m["polygons"])
-        rec, _ = penumbra_job.run_cli(exe, scene, work, name, {}, keep=False,
-                                      timeout=cfg.scaling_timeout)
-        rows.append(dict(scene=name, triangles=tris, furniture_triangles=furn,
-                         wall=rec["wall"], peak_mb=rec["peak_mb"], stats=rec["stats"],
-                         timed_out=rec["timed_out"]))
-        if rec["timed_out"]:
-            log(f"  stopped after {cfg.scaling_timeout} s")
+        for mode, settings in SCALING_MODES.items():
+            # A mode stopped at one size is not attempted at the larger ones.
+            if mode in stopped:
+                continue
+            log(f"scaling {name} ({mode})")
+            rec, _ = penumbra_job.run_cli(exe, scene, work, f"{name}-{mode}", settings,
+                                          keep=False, timeout=cfg.scaling_timeout)
+            rows.append(dict(scene=name, mode=mode, triangles=tris, furniture_triangles=furn,
+                             wall=rec["wall"], peak_mb=rec["peak_mb"], stats=rec["stats"],
+                             timed_out=rec["timed_out"]))
+            if rec["timed_out"]:
+                log(f"  stopped after {cfg.scaling_timeout} s")
+                stopped.add(mode)
+        if len(stopped) == len(SCALING_MODES):
             break
     return rows
 

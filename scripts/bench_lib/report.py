@@ -107,21 +107,27 @@ def plots(res, out):
         fig.savefig(os.path.join(out, files["error_vs_elements"]), dpi=110)
         plt.close(fig)
 
-    sc = [r for r in res["scaling"] if not r.get("timed_out")]
-    if sc:
-        x = [r["triangles"] for r in sc]
-        fig, ax = plt.subplots(figsize=(5, 3.6))
-        t = [r["wall"] for r in sc]
-        m = [r["peak_mb"] / 1024 for r in sc]
-        ax.loglog(x, t, "o-", label=f"wall time (s), exponent {fit_exponent(x, t):.2f}")
-        ax.loglog(x, m, "s--", label=f"peak memory (GB), exponent {fit_exponent(x, m):.2f}")
-        for r in res["scaling"]:
-            if r.get("timed_out"):
-                ax.loglog([r["triangles"]], [r["wall"]], "r^",
-                          label=f"stopped at {r['wall']:.0f} s (lower bound)")
+    if any(not r.get("timed_out") for r in res["scaling"]):
+        fig, ax = plt.subplots(figsize=(5.6, 4.0))
+        for mode, style in [("full", ("o-", "s--", "C0")), ("direct", ("o:", "s-.", "C1"))]:
+            rows = scaling_rows(res, mode)
+            sc = [r for r in rows if not r.get("timed_out")]
+            if not sc:
+                continue
+            x = [r["triangles"] for r in sc]
+            t = [r["wall"] for r in sc]
+            m = [r["peak_mb"] / 1024 for r in sc]
+            ax.loglog(x, t, style[0], color=style[2],
+                      label=f"{mode}: wall time (s), exponent {fit_exponent(x, t):.2f}")
+            ax.loglog(x, m, style[1], color=style[2], alpha=0.6,
+                      label=f"{mode}: peak memory (GB), exponent {fit_exponent(x, m):.2f}")
+            for r in rows:
+                if r.get("timed_out"):
+                    ax.loglog([r["triangles"]], [r["wall"]], "^", color=style[2],
+                              label=f"{mode}: stopped at {r['wall']:.0f} s (lower bound)")
         ax.set_xlabel("triangles in the scene (room-N)")
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
+        ax.legend(fontsize=7)
         fig.tight_layout()
         files["scaling"] = "scaling.png"
         fig.savefig(os.path.join(out, files["scaling"]), dpi=110)
@@ -173,7 +179,7 @@ def targets(res):
         d = next(r for r in res["scenes"]["data2"]["full_rows"]
                  if r["method"] == "Penumbra default")
         rows.append(("Data 2 whole bake ≤ 2 s", f"{fmt(d['wall'])} s", d["wall"] <= 2.0))
-    sc = res["scaling"]
+    sc = scaling_rows(res, "full")
     big = [r for r in sc if r["furniture_triangles"] >= 90_000]
     if big:
         r = big[-1]
@@ -204,6 +210,12 @@ def targets(res):
     return rows
 
 
+def scaling_rows(res, mode):
+    """The scaling rows of one mode ("full" or "direct"); rows of results written before
+    the direct series existed are full bakes."""
+    return [r for r in res["scaling"] if r.get("mode", "full") == mode]
+
+
 def findings(res):
     """Plain statements derived from the numbers: dominant stages, where we lose."""
     out = []
@@ -230,12 +242,13 @@ def findings(res):
         if st.get("N_p", 0) == 0 and st.get("T_rs", 0) == 0:
             out.append(f"{name}: no indirect light in this build (N_p = 0, T_rs = 0): the "
                        f"full-problem error is the missing indirect light, not meshing.")
-    for r in [r for r in res["scaling"] if not r.get("timed_out")][-1:]:
-        st = r["stats"]
-        parts = {k: st[k] for k in STAGES}
-        k, v = max(parts.items(), key=lambda kv: kv[1])
-        out.append(f"{r['scene']} ({r['triangles']:,} triangles): largest stage {k} = "
-                   f"{fmt(v)} s of {fmt(r['wall'])} s.")
+    for mode in ("full", "direct"):
+        for r in [r for r in scaling_rows(res, mode) if not r.get("timed_out")][-1:]:
+            st = r["stats"]
+            parts = {k: st[k] for k in STAGES}
+            k, v = max(parts.items(), key=lambda kv: kv[1])
+            out.append(f"{r['scene']} ({r['triangles']:,} triangles, {mode} bake): largest "
+                       f"stage {k} = {fmt(v)} s of {fmt(r['wall'])} s.")
     return out
 
 
@@ -326,23 +339,31 @@ def write(res, out):
     sc = res["scaling"]
     rows = []
     for r in sc:
+        mode = r.get("mode", "full")
         if r.get("timed_out"):
-            rows.append([r["scene"], fmt(r["furniture_triangles"]), fmt(r["triangles"]),
+            rows.append([r["scene"], mode, fmt(r["furniture_triangles"]), fmt(r["triangles"]),
                          f"> {fmt(r['wall'])} (stopped)", f"≥ {fmt(r['peak_mb'])}"]
-                        + ["–"] * 5)
+                        + ["–"] * 8)
             continue
-        rows.append([r["scene"], fmt(r["furniture_triangles"]), fmt(r["triangles"]),
-                     fmt(r["wall"]), fmt(r["peak_mb"]), fmt(r["stats"]["N_e"]),
-                     fmt(t_d(r["stats"])), fmt(r["stats"]["T_m"]),
-                     fmt(r["stats"]["T_direct"]), fmt(r["stats"]["T_rs"])])
-    L.append(table(["scene", "furniture tris", "all tris", "wall (s)", "peak (MB)",
-                    "elements", "T_d", "T_m", "T_direct", "T_rs"], rows) + "\n")
-    sc = [r for r in sc if not r.get("timed_out")]
-    if len(sc) >= 2:
-        x = [r["triangles"] for r in sc]
-        L.append(f"Fitted exponents (log-log, finished sizes): time "
-                 f"{fit_exponent(x, [r['wall'] for r in sc]):.2f}, peak memory "
-                 f"{fit_exponent(x, [r['peak_mb'] for r in sc]):.2f}.\n")
+        st = r["stats"]
+        rows.append([r["scene"], mode, fmt(r["furniture_triangles"]), fmt(r["triangles"]),
+                     fmt(r["wall"]), fmt(r["peak_mb"]), fmt(st["N_e"]), fmt(st.get("N_f2")),
+                     fmt(st["T_sdw"] + st["T_isr"]), fmt(t_d(st) - st["T_sdw"] - st["T_isr"]),
+                     fmt(st["T_m"]), fmt(st["T_direct"]), fmt(st["T_rs"])])
+    L.append("Each size is baked twice: the full bake (direct + indirect, the issue's "
+             "targets) and direct light only (`\"indirect\": false`). T_sdw+isr: shadow "
+             "volumes and their polygons on the receivers; T_arr: edge cutting, "
+             "arrangement, relations and merging (T_idd + T_lop + T_lit + T_div).\n")
+    L.append(table(["scene", "mode", "furniture tris", "all tris", "wall (s)", "peak (MB)",
+                    "elements", "N_f2", "T_sdw+isr", "T_arr", "T_m", "T_direct", "T_rs"],
+                   rows) + "\n")
+    for mode in ("full", "direct"):
+        done = [r for r in scaling_rows(res, mode) if not r.get("timed_out")]
+        if len(done) >= 2:
+            x = [r["triangles"] for r in done]
+            L.append(f"Fitted exponents, {mode} bake (log-log over {len(done)} finished "
+                     f"sizes): time {fit_exponent(x, [r['wall'] for r in done]):.2f}, peak "
+                     f"memory {fit_exponent(x, [r['peak_mb'] for r in done]):.2f}.\n")
     if "scaling" in files:
         L.append(f"![scaling]({files['scaling']})\n")
     if "render" in files:

@@ -30,7 +30,8 @@ use robust::{orient3d, Coord3D};
 
 use crate::geom::lambert::{contours_irradiance, polygon_irradiance};
 use crate::geom::plane::newell_normal;
-use crate::geom::polygon::{clip_polygon_3d, signed_area_2d};
+use crate::geom::box_grid::bounds;
+use crate::geom::polygon::{clip_polygon_3d, inside_convex, signed_area_2d};
 use crate::geom::{Frame, Plane};
 use crate::relation::Relation;
 use crate::scene::Spot;
@@ -129,16 +130,64 @@ impl View<'_> {
     fn exact_visible(&self, blockers: &[Vec<DVec3>], unoccluded: f64) -> f64 {
         let View { q, n, light, .. } = *self;
         let reach = light.iter().map(|l| (*l - q).length()).fold(0.0, f64::max);
-        let hidden: Vec<Vec<DVec3>> = blockers
-            .iter()
-            .filter_map(|o| self.hidden_part(o, reach))
-            .collect();
+        let mut hidden: Vec<Vec<DVec3>> = Vec::with_capacity(blockers.len());
+        for o in blockers {
+            if let Some(h) = self.hidden_part(o, reach) {
+                // No clipping plane cut the light: all of it is hidden.
+                if h.as_slice() == light {
+                    return 0.0;
+                }
+                hidden.push(h);
+            }
+        }
+        if hidden.len() > 1 {
+            hidden = self.drop_nested(hidden);
+        }
         match hidden.len() {
             0 => unoccluded,
             // One hidden part lies inside the light, so the visible integral is a difference.
             1 => (unoccluded - polygon_irradiance(q, n, &hidden[0])).clamp(0.0, unoccluded),
             _ => self.light_minus_union(&hidden).min(unoccluded),
         }
+    }
+
+    /// The hidden parts without those inside another one (exact test in the light's plane):
+    /// the union is the same, and among many small occluders behind a large one (clutter
+    /// seen through a table) most parts are nested.
+    fn drop_nested(&self, hidden: Vec<Vec<DVec3>>) -> Vec<Vec<DVec3>> {
+        let frame = Frame::new(DVec3::ZERO, self.ln);
+        let flat: Vec<Vec<DVec2>> = hidden
+            .iter()
+            .map(|h| {
+                let mut c: Vec<DVec2> = h.iter().map(|v| frame.to_2d(*v)).collect();
+                if signed_area_2d(&c) < 0.0 {
+                    c.reverse();
+                }
+                c
+            })
+            .collect();
+        let area: Vec<f64> = flat.iter().map(|c| signed_area_2d(c)).collect();
+        let mut order: Vec<usize> = (0..flat.len()).collect();
+        order.sort_by(|&a, &b| area[b].total_cmp(&area[a]).then(a.cmp(&b)));
+        let boxes: Vec<(DVec2, DVec2)> = flat.iter().map(|c| bounds(c)).collect();
+        let mut kept: Vec<usize> = Vec::with_capacity(flat.len());
+        for &i in &order {
+            let (lo, hi) = boxes[i];
+            let nested = kept.iter().any(|&j| {
+                let (jlo, jhi) = boxes[j];
+                jlo.x <= lo.x
+                    && jlo.y <= lo.y
+                    && jhi.x >= hi.x
+                    && jhi.y >= hi.y
+                    && flat[i].iter().all(|&v| inside_convex(&flat[j], v))
+            });
+            if !nested {
+                kept.push(i);
+            }
+        }
+        kept.sort_unstable();
+        let mut hidden: Vec<Option<Vec<DVec3>>> = hidden.into_iter().map(Some).collect();
+        kept.iter().filter_map(|&i| hidden[i].take()).collect()
     }
 
     /// Irradiance per unit radiance from the light minus the union of several hidden parts,

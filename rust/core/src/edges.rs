@@ -15,6 +15,7 @@ use crate::geom::polygon::{
 use crate::geom::{Frame, Plane};
 use crate::scene::solids::Occluder;
 use crate::scene::{Face, LightKind, Scene};
+use crate::screens::{screen_faces, screened};
 use crate::shadow::{shadow_volumes, solid_volumes, ShadowVolumes, SolidShadow, Volume};
 
 /// `occluder` value of the polygon that marks the part of a receiver behind an area light's
@@ -219,9 +220,24 @@ pub fn shadow_polygons(
                 out
             })
             .collect();
+        let light_points: Vec<DVec3> = match &light.kind {
+            LightKind::Area { verts, .. } => verts.clone(),
+            LightKind::Point { position, .. } => vec![*position],
+            LightKind::Sun { .. } => Vec::new(),
+        };
+        let screens: Vec<Vec<u32>> = found
+            .par_iter()
+            .enumerate()
+            .map(|(oi, rs)| {
+                let own = |f: u32| scene.face_occluder[f as usize] as usize == oi;
+                screen_faces(&light_points, &outlines[oi].0, rs, faces, own, eps)
+            })
+            .collect();
         for (oi, rs) in found.iter().enumerate() {
             for &r in rs {
-                if scene.face_occluder[r as usize] as usize != oi {
+                if scene.face_occluder[r as usize] as usize != oi
+                    && !screened(&faces[r as usize], &screens[oi], faces, eps)
+                {
                     hits[r as usize].push(oi as u32);
                 }
             }
@@ -271,6 +287,11 @@ pub fn shadow_polygons(
         }
         stats.t_isr += t1.elapsed().as_secs_f64();
     }
+    let t2 = std::time::Instant::now();
+    per_receiver
+        .par_iter_mut()
+        .for_each(|r| crate::umbra_cover::drop_covered(&mut r.polys));
+    stats.t_isr += t2.elapsed().as_secs_f64();
     Ok((per_receiver, stats))
 }
 

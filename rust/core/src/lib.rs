@@ -21,7 +21,9 @@ pub mod regions;
 pub mod relation;
 pub mod scene;
 pub mod settings;
+pub mod screens;
 pub mod shadow;
+pub mod umbra_cover;
 pub mod vertex_light;
 
 pub use bake::{bake, bake_scene_json, Bake, BakedMesh, Stats};

@@ -16,7 +16,7 @@ use spade::{
 use crate::arrangement::ArrFace;
 use crate::edges::ReceiverShadows;
 use crate::geom::polygon::orient;
-use crate::regions::{classify_point, ReceiverRegions, RegionFace};
+use crate::regions::{Indexed, ReceiverRegions, RegionFace};
 use crate::relation::Relation;
 use crate::settings::Settings;
 use crate::BakeError;
@@ -226,6 +226,7 @@ fn extract(cdt: &Cdt, sh: &ReceiverShadows, uniform: bool, diag: f64) -> Receive
     }
     let mut comp = vec![u32::MAX; faces.len()];
     let mut regions: Vec<RegionFace> = Vec::new();
+    let index = Indexed::new(&sh.polys, &sh.inside);
     for start in 0..faces.len() {
         if comp[start] != u32::MAX {
             continue;
@@ -253,7 +254,7 @@ fn extract(cdt: &Cdt, sh: &ReceiverShadows, uniform: bool, diag: f64) -> Receive
             }
         }
         let c = faces[best.1].center();
-        regions.push(classify_point(sh, DVec2::new(c.x, c.y)));
+        regions.push(index.classify(DVec2::new(c.x, c.y), &sh.exposure));
     }
 
     // D0 split: group the triangles around each vertex into sectors that do not cross a

@@ -8,9 +8,11 @@ use glam::DVec2;
 
 use crate::arrangement::{self, Arrangement, Segment, BOUNDARY_TAG};
 use crate::edges::{Exposure, ReceiverShadows, ShadowPolygon};
+use crate::geom::box_grid::{bounds, BoxGrid};
 use crate::geom::polygon::inside_convex;
 use crate::relation::Relation;
 use crate::scene::Face;
+use crate::umbra_cover::UmbraCover;
 
 /// A face of the arrangement with its light relations.
 #[derive(Debug, Clone)]
@@ -34,31 +36,23 @@ pub struct ReceiverRegions {
     pub n_regions: u64,
 }
 
-/// Bounding boxes of shadow polygons, for a cheap first test.
-struct Indexed<'a> {
+/// Shadow polygons with their bounding boxes in a grid, for a cheap first test.
+pub struct Indexed<'a> {
     polys: &'a [ShadowPolygon],
     boxes: Vec<(DVec2, DVec2)>,
+    grid: BoxGrid,
     /// Parts of the receiver inside closed solids.
     inside: &'a [Vec<DVec2>],
 }
 
 impl<'a> Indexed<'a> {
-    fn new(polys: &'a [ShadowPolygon], inside: &'a [Vec<DVec2>]) -> Self {
-        let boxes = polys
-            .iter()
-            .map(|p| {
-                let mut lo = DVec2::splat(f64::INFINITY);
-                let mut hi = DVec2::splat(f64::NEG_INFINITY);
-                for q in &p.poly {
-                    lo = lo.min(*q);
-                    hi = hi.max(*q);
-                }
-                (lo, hi)
-            })
-            .collect();
+    pub fn new(polys: &'a [ShadowPolygon], inside: &'a [Vec<DVec2>]) -> Self {
+        let boxes: Vec<(DVec2, DVec2)> = polys.iter().map(|p| bounds(&p.poly)).collect();
+        let grid = BoxGrid::new(&boxes);
         Indexed {
             polys,
             boxes,
+            grid,
             inside,
         }
     }
@@ -79,7 +73,8 @@ impl<'a> Indexed<'a> {
                 relations[l] = Relation::Umbra;
             }
         }
-        for (p, (lo, hi)) in self.polys.iter().zip(&self.boxes) {
+        for &k in self.grid.at(q) {
+            let (p, (lo, hi)) = (&self.polys[k as usize], &self.boxes[k as usize]);
             let l = p.light as usize;
             if relations[l] == Relation::Umbra
                 || q.x < lo.x
@@ -147,28 +142,44 @@ pub fn build_regions(
         );
     }
     let t0 = std::time::Instant::now();
+    let extent = r
+        .poly2
+        .iter()
+        .map(|p| (*p - r.poly2[0]).length())
+        .fold(0.0, f64::max)
+        .max(diag * 1e-9);
+    let snap = 1e-9 * extent;
+    // Parts of edges deep inside an umbra of their own light would only be dropped again
+    // after the arrangement; a few snap distances keep rounding off the umbra boundaries.
+    let cover = UmbraCover::new(&sh.polys, 8.0 * snap);
+    let (mut scratch, mut pieces) = (Vec::new(), Vec::new());
     let mut segs = Vec::new();
     for (k, p) in sh.polys.iter().enumerate() {
         for i in 0..p.poly.len() {
             let a = p.poly[i];
             let b = p.poly[(i + 1) % p.poly.len()];
             if a != b && !on_boundary(&r.poly2, a, b, 1e-10 * diag) {
-                segs.push(Segment {
+                pieces.clear();
+                cover.uncovered(a, b, p.light, Some(k as u32), &mut scratch, &mut pieces);
+                segs.extend(pieces.iter().map(|&(a, b)| Segment {
                     a,
                     b,
                     tag: k as u32,
-                });
+                }));
             }
         }
     }
     let n_polys = sh.polys.len() as u32;
-    for (k, (_, [a, b])) in sh.events.iter().enumerate() {
-        segs.push(Segment {
-            a: *a,
-            b: *b,
+    for (k, (l, [a, b])) in sh.events.iter().enumerate() {
+        pieces.clear();
+        cover.uncovered(*a, *b, *l, None, &mut scratch, &mut pieces);
+        segs.extend(pieces.iter().map(|&(a, b)| Segment {
+            a,
+            b,
             tag: n_polys + k as u32,
-        });
+        }));
     }
+    // Plane cuts are kept whole: they belong to every light, so no one umbra covers them.
     let n_events = sh.events.len() as u32;
     for (k, [a, b]) in sh.plane_cuts.iter().enumerate() {
         segs.push(Segment {
@@ -179,13 +190,7 @@ pub fn build_regions(
     }
     let t_idd = t0.elapsed().as_secs_f64();
     let t1 = std::time::Instant::now();
-    let extent = r
-        .poly2
-        .iter()
-        .map(|p| (*p - r.poly2[0]).length())
-        .fold(0.0, f64::max)
-        .max(diag * 1e-9);
-    let arr = arrangement::build(&r.poly2, &segs, 1e-9 * extent);
+    let arr = arrangement::build(&r.poly2, &segs, snap);
     let t_lop = t1.elapsed().as_secs_f64();
 
     let t2 = std::time::Instant::now();

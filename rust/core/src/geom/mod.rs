@@ -2,6 +2,7 @@
 //! queries. Geometric *decisions* that must be exact go through `robust` predicates; the
 //! clipping here computes coordinates and is allowed to round.
 
+pub mod box_grid;
 pub mod bvh;
 pub mod frame;
 pub mod lambert;

@@ -1,0 +1,237 @@
+//! What lies inside another occluder's umbra on a receiver is no discontinuity: every point
+//! there is in umbra of that light whatever else hides it, so both sides of an edge there
+//! are umbra (the redundancy rule of `regions` would drop the edge after paying for its
+//! crossings), and a shadow polygon wholly inside an umbra polygon decides nothing. Among
+//! many small occluders (clutter on a table, a table over a floor) most shadow edges lie in
+//! such umbrae and their crossings grow with the square of their number; taking them out
+//! first keeps the arrangement near the size of the visible shadow boundaries.
+//!
+//! Exactness: a polygon is dropped only when an exact predicate puts all its vertices on or
+//! inside a kept umbra polygon of the same light. A segment loses the part inside an umbra
+//! polygon of its light (cut where it crosses the boundary, so the pieces left end on it),
+//! and only when some of it lies inside by more than `margin` (distance to every edge line):
+//! rounding can never remove a piece of edge that runs along an umbra boundary.
+
+use glam::DVec2;
+
+use crate::edges::ShadowPolygon;
+use crate::geom::box_grid::{bounds, BoxGrid};
+use crate::geom::polygon::{inside_convex, signed_area_2d};
+
+/// Removes from `polys` every polygon that lies inside another (kept) umbra polygon of the
+/// same light. Of several equal umbra polygons the first is kept.
+pub fn drop_covered(polys: &mut Vec<ShadowPolygon>) {
+    let umbrae: Vec<u32> = (0..polys.len() as u32)
+        .filter(|&i| polys[i as usize].umbra)
+        .collect();
+    if umbrae.is_empty() || polys.len() < 2 {
+        return;
+    }
+    let boxes: Vec<(DVec2, DVec2)> = umbrae
+        .iter()
+        .map(|&i| bounds(&polys[i as usize].poly))
+        .collect();
+    let area: Vec<f64> = polys.iter().map(|p| signed_area_2d(&p.poly)).collect();
+    let grid = BoxGrid::new(&boxes);
+    let mut cand = Vec::new();
+    let keep: Vec<bool> = (0..polys.len())
+        .map(|i| {
+            let p = &polys[i];
+            let (lo, hi) = bounds(&p.poly);
+            grid.meeting(lo, hi, &mut cand);
+            !cand.iter().any(|&u| {
+                let j = umbrae[u as usize] as usize;
+                let (ulo, uhi) = boxes[u as usize];
+                let q = &polys[j];
+                // A larger umbra, or an equal one earlier in the list (equal areas and
+                // mutual containment mean the same polygon: one of them must stay).
+                j != i
+                    && q.light == p.light
+                    && ulo.x <= lo.x
+                    && ulo.y <= lo.y
+                    && uhi.x >= hi.x
+                    && uhi.y >= hi.y
+                    && (area[j] > area[i] || (area[j] == area[i] && j < i))
+                    && p.poly.iter().all(|&v| inside_convex(&q.poly, v))
+            })
+        })
+        .collect();
+    let mut k = 0;
+    polys.retain(|_| {
+        k += 1;
+        keep[k - 1]
+    });
+}
+
+/// The umbra polygons of one receiver, for cutting segments.
+pub struct UmbraCover<'a> {
+    polys: &'a [ShadowPolygon],
+    umbrae: Vec<u32>,
+    grid: BoxGrid,
+    margin: f64,
+}
+
+impl<'a> UmbraCover<'a> {
+    pub fn new(polys: &'a [ShadowPolygon], margin: f64) -> Self {
+        let umbrae: Vec<u32> = (0..polys.len() as u32)
+            .filter(|&i| polys[i as usize].umbra && polys[i as usize].poly.len() >= 3)
+            .collect();
+        let boxes: Vec<(DVec2, DVec2)> = umbrae
+            .iter()
+            .map(|&i| bounds(&polys[i as usize].poly))
+            .collect();
+        UmbraCover {
+            polys,
+            umbrae,
+            grid: BoxGrid::new(&boxes),
+            margin,
+        }
+    }
+
+    /// The pieces of segment `a`–`b` (an edge made by `light`, from polygon `own` if any)
+    /// that are not deep inside an umbra polygon of that light, appended to `out`.
+    pub fn uncovered(
+        &self,
+        a: DVec2,
+        b: DVec2,
+        light: u32,
+        own: Option<u32>,
+        scratch: &mut Vec<u32>,
+        out: &mut Vec<(DVec2, DVec2)>,
+    ) {
+        if self.umbrae.is_empty() {
+            out.push((a, b));
+            return;
+        }
+        self.grid.meeting(a.min(b), a.max(b), scratch);
+        let mut cut: Vec<(f64, f64)> = Vec::new();
+        let d = b - a;
+        for &u in scratch.iter() {
+            let j = self.umbrae[u as usize];
+            let q = &self.polys[j as usize];
+            if q.light != light || Some(j) == own {
+                continue;
+            }
+            // Decided with the margin, cut where the segment crosses the boundary: the
+            // pieces left then end on the umbra's edges (the arrangement snaps them there)
+            // instead of leaving stubs inside that would stay as dangling edges.
+            if let Some(deep) = deep_inside(&q.poly, a, d, self.margin) {
+                cut.push(deep_inside(&q.poly, a, d, 0.0).unwrap_or(deep));
+            }
+        }
+        if cut.is_empty() {
+            out.push((a, b));
+            return;
+        }
+        cut.sort_by(|x, y| x.0.total_cmp(&y.0));
+        let at = |t: f64| if t >= 1.0 { b } else { a + d * t };
+        let mut t = 0.0;
+        for (t0, t1) in cut {
+            if t0 > t {
+                out.push((at(t), at(t0)));
+            }
+            t = t.max(t1);
+        }
+        if t < 1.0 {
+            out.push((at(t), b));
+        }
+    }
+}
+
+/// The parameter interval of `a + t·d`, t in [0, 1], that lies farther than `margin` inside
+/// every edge line of convex counter-clockwise `poly`, if not empty.
+fn deep_inside(poly: &[DVec2], a: DVec2, d: DVec2, margin: f64) -> Option<(f64, f64)> {
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    let n = poly.len();
+    for i in 0..n {
+        let (p, q) = (poly[i], poly[(i + 1) % n]);
+        let e = q - p;
+        let len = e.length();
+        if !(len > 0.0) {
+            continue;
+        }
+        // Signed distance inside the edge line at t: f0 + t·df.
+        let f0 = e.perp_dot(a - p) / len - margin;
+        let df = e.perp_dot(d) / len;
+        if df == 0.0 {
+            if !(f0 > 0.0) {
+                return None;
+            }
+        } else {
+            let t = -f0 / df;
+            if df > 0.0 {
+                t0 = t0.max(t);
+            } else {
+                t1 = t1.min(t);
+            }
+        }
+        if !(t0 < t1) {
+            return None;
+        }
+    }
+    Some((t0, t1))
+}
+
+#[cfg(test)]
+mod test {
+    use super::*;
+
+    fn sq(x0: f64, y0: f64, x1: f64, y1: f64, umbra: bool, occluder: u32) -> ShadowPolygon {
+        ShadowPolygon {
+            light: 0,
+            occluder,
+            umbra,
+            hard: false,
+            poly: vec![
+                DVec2::new(x0, y0),
+                DVec2::new(x1, y0),
+                DVec2::new(x1, y1),
+                DVec2::new(x0, y1),
+            ],
+        }
+    }
+
+    #[test]
+    fn drops_only_polygons_inside_a_kept_umbra_of_the_same_light() {
+        let mut other_light = sq(0.2, 0.2, 0.4, 0.4, false, 3);
+        other_light.light = 1;
+        let mut polys = vec![
+            sq(0.0, 0.0, 1.0, 1.0, true, 0),
+            sq(0.1, 0.1, 0.5, 0.5, false, 1),
+            sq(0.5, 0.5, 1.5, 1.5, false, 2),
+            other_light,
+            // The same umbra twice: one copy stays.
+            sq(0.0, 0.0, 1.0, 1.0, true, 4),
+            // Touching the boundary from inside is inside.
+            sq(0.0, 0.0, 1.0, 0.5, false, 5),
+        ];
+        drop_covered(&mut polys);
+        let left: Vec<u32> = polys.iter().map(|p| p.occluder).collect();
+        assert_eq!(left, vec![0, 2, 3]);
+    }
+
+    #[test]
+    fn cuts_segments_deep_inside_and_keeps_edges_along_boundaries() {
+        let polys = vec![sq(0.0, 0.0, 1.0, 1.0, true, 0), sq(2.0, 0.0, 3.0, 1.0, true, 1)];
+        let cover = UmbraCover::new(&polys, 1e-9);
+        let (mut s, mut out) = (Vec::new(), Vec::new());
+        // Through both squares: the three pieces outside them, ending on their boundaries.
+        let (a, b) = (DVec2::new(-1.0, 0.5), DVec2::new(4.0, 0.5));
+        cover.uncovered(a, b, 0, None, &mut s, &mut out);
+        assert_eq!(out.len(), 3);
+        assert!(out[0].1.x.abs() < 1e-15 && (out[1].0.x - 1.0).abs() < 1e-15);
+        // Along the square's edge, or from another light: untouched.
+        for (a, b, l) in [
+            (DVec2::new(0.0, -1.0), DVec2::new(0.0, 2.0), 0),
+            (DVec2::new(-1.0, 0.5), DVec2::new(4.0, 0.5), 1),
+        ] {
+            out.clear();
+            cover.uncovered(a, b, l, None, &mut s, &mut out);
+            assert_eq!(out, vec![(a, b)]);
+        }
+        // Wholly inside: nothing left.
+        out.clear();
+        cover.uncovered(DVec2::new(0.2, 0.2), DVec2::new(0.8, 0.3), 0, None, &mut s, &mut out);
+        assert!(out.is_empty());
+    }
+}
