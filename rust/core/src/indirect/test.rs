@@ -2,6 +2,7 @@
 
 use super::*;
 use crate::geom::raycast::test::face;
+use crate::geom::Plane;
 use crate::patches::test::grid_elements;
 use crate::scene::json::SettingsJson;
 use crate::scene::Face;
