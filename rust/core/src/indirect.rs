@@ -14,6 +14,7 @@
 //! computed alone and added in a fixed order, so results do not depend on the thread count.
 
 mod blockers;
+mod fit;
 mod receiver;
 mod shooter;
 

@@ -8,7 +8,7 @@ use std::sync::OnceLock;
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::blockers::{Pair, Reached};
+use super::blockers::{Blockers, Pair, Reached};
 use super::{mean, CHUNK, FACTOR_BUDGET};
 use crate::elements::Elements;
 use crate::geom::raycast::Occluders;
@@ -48,6 +48,10 @@ pub(super) struct Shooter<'a> {
     /// (in a closed room, many times), and the geometry has not changed.
     pub(super) factors: Vec<OnceLock<Factors>>,
     pub(super) factors_kept: AtomicUsize,
+    /// Whether far vertex groups may be fitted (`fit.rs`) instead of evaluated vertex by
+    /// vertex, and how many vertices were.
+    pub(super) fit: bool,
+    pub(super) fitted_verts: AtomicUsize,
 }
 
 /// A patch's shot, kept for the next: form factor times visibility for the vertices
@@ -177,6 +181,8 @@ impl<'a> Shooter<'a> {
             kept: AtomicUsize::new(0),
             factors: (0..patches.len()).map(|_| OnceLock::new()).collect(),
             factors_kept: AtomicUsize::new(0),
+            fit: true,
+            fitted_verts: AtomicUsize::new(0),
         }
     }
 
@@ -226,6 +232,12 @@ impl<'a> Shooter<'a> {
                 let mut out = Vec::new();
                 for group in &self.groups[g0..g1] {
                     let blockers = self.blockers(patch.face, &plane, pair, group);
+                    if self.fit && matches!(blockers, Blockers::None) {
+                        if let Some(vals) = self.fitted(patch, &plane, pair, group) {
+                            out.extend(vals);
+                            continue;
+                        }
+                    }
                     let verts = &self.face_verts[group.start as usize..group.end as usize];
                     out.extend(
                         verts
