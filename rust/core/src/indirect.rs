@@ -9,9 +9,15 @@
 //! fraction from rays to stratified points on the patch, each ray weighted by its own
 //! point-to-point form factor. Most pairs need no rays: a face can only be in the way if it
 //! pokes out in front of both the shooter's and the receiver's planes inside the box around
-//! the shooter and a group of receiver vertices ([`Occluders::candidates`]), which for
-//! convex objects and floors is never. Rays to far patches are fewer (1 or ~4). Shots are parallel over receiver vertices; each vertex's value is
-//! computed alone and added in a fixed order, so results do not depend on the thread count.
+//! the shooter and a group of receiver vertices ([`Occluders::candidates`]), and its plane
+//! has the shooter and the group on opposite sides ([`Occluders::straddled_by`]), which for
+//! convex objects and floors is never. Rays to far patches are fewer (1 or ~4). Far groups
+//! with nothing in the way take the factor from an interpolant checked against exact values
+//! (`fit`). Shots are parallel over receiver vertices; each vertex's value is computed
+//! alone and added in a fixed order, so results do not depend on the thread count.
+//!
+//! Files: `shooter` (a shot and its kept factors), `blockers` (what could be in the way),
+//! `receiver` (one vertex's factor), `fit` (far groups).
 
 mod blockers;
 mod fit;
