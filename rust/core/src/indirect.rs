@@ -63,8 +63,9 @@ const MAX_LISTED_OCCLUDERS: usize = 24;
 const MAX_FACE_OCCLUDERS: usize = 64;
 /// Face ids kept in those lists over the whole bake (4 bytes each).
 const FACE_OCCLUDER_BUDGET: usize = 1 << 24;
-/// Form factors kept for repeat shots, over the whole bake (4 bytes each: 256 MB at most;
-/// a closed room of 24k vertices and 2.6k patches keeps 41M).
+/// Form factors kept for repeat shots, over the whole bake, in 4-byte units (256 MB at
+/// most): a vertex's factor is one, a run of vertices two, a receiving patch's gain four.
+/// A closed room of 24k vertices and 2.6k patches keeps about 41M.
 const FACTOR_BUDGET: usize = 1 << 26;
 /// Receiver vertices per parallel work item.
 const CHUNK: usize = 256;

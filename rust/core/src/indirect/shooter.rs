@@ -292,7 +292,7 @@ impl<'a> Shooter<'a> {
                 }
             }
         }
-        let n = known.factors.len() + 2 * known.runs.len() + 3 * known.to_patches.len();
+        let n = known.factors.len() + 2 * known.runs.len() + 4 * known.to_patches.len();
         if self.factors_kept.load(Ordering::Relaxed) + n <= FACTOR_BUDGET {
             self.factors_kept.fetch_add(n, Ordering::Relaxed);
             return (
