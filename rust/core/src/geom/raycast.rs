@@ -267,6 +267,27 @@ impl Occluders {
         (f.lo - self.pad).cmple(hi + self.pad).all() && (f.hi + self.pad).cmpge(lo - self.pad).all()
     }
 
+    /// Whether face `id` could cross a segment from a point of the convex hull of `a` to a
+    /// point of the box `lo`–`hi` (grown by the padding): only if its plane has points of
+    /// both on opposite sides, each more than the tolerance off it. A face whose plane
+    /// leaves the two on one side can be dropped from a list of blockers between them.
+    pub fn straddled_by(&self, id: u32, a: &[DVec3], lo: DVec3, hi: DVec3) -> bool {
+        let f = &self.faces[id as usize];
+        if f.edges.is_empty() {
+            return false;
+        }
+        let (mut a_lo, mut a_hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for p in a {
+            let d = f.plane.dist(*p);
+            a_lo = a_lo.min(d);
+            a_hi = a_hi.max(d);
+        }
+        let c = f.plane.dist((lo + hi) * 0.5);
+        let r = f.plane.n.abs().dot((hi - lo) * 0.5 + self.pad);
+        let (b_lo, b_hi) = (c - r, c + r);
+        (a_hi > self.tol && b_lo < -self.tol) || (a_lo < -self.tol && b_hi > self.tol)
+    }
+
     fn face_crosses_segment(&self, id: u32, a: DVec3, b: DVec3) -> bool {
         let f = &self.faces[id as usize];
         if f.edges.is_empty() {

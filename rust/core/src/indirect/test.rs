@@ -2,6 +2,7 @@
 
 use super::*;
 use crate::geom::raycast::test::face;
+use crate::geom::Plane;
 use crate::patches::test::grid_elements;
 use crate::scene::json::SettingsJson;
 use crate::scene::Face;
@@ -530,4 +531,79 @@ fn room_timing() {
         quad(b + by, bz, bx, 0.5, DVec3::ZERO),
     ]);
     time_scene("room with sphere and box", room, 0.12, v(0.3, 0.2, 2.9));
+}
+
+/// Per element vertex, what patch `p` sends it per unit radiosity, as the shooter computes it.
+fn factors_of(sh: &Shooter, p: usize, nv: usize) -> Vec<f64> {
+    let (known, exact) = sh.factors(p, DVec3::ONE);
+    let exact = exact.expect("first shot of the patch");
+    let mut out = vec![0.0; nv];
+    let verts = known
+        .runs
+        .iter()
+        .flat_map(|&(s, e)| &sh.face_verts[s as usize..e as usize]);
+    for (&v, g) in verts.zip(exact) {
+        out[v as usize] = g;
+    }
+    out
+}
+
+#[test]
+fn fitted_far_groups_agree_with_vertex_by_vertex() {
+    // A small lamp high over a floor and a tilted panel: every patch of it is far from the
+    // receivers' vertex groups, and nothing stands in between.
+    let lamp = quad(
+        v(0.2, 0.1, 3.0),
+        DVec3::Y * 0.15,
+        DVec3::X * 0.15,
+        0.0,
+        DVec3::ONE,
+    );
+    let floor = quad(DVec3::ZERO, DVec3::X, DVec3::Y, 0.5, DVec3::ZERO);
+    let panel = quad(
+        v(-2.0, 0.0, 1.0),
+        v(0.0, 1.0, 0.0),
+        v(0.3, 0.0, 0.8),
+        0.5,
+        DVec3::ZERO,
+    );
+    let sc = scene(vec![lamp, floor, panel], |s| s.patch_size = 0.5);
+    let el = grid_elements(&sc.faces, 40);
+    let occ = Occluders::new(&sc.faces);
+    let patches = build_patches(&sc.faces, &el, 0.5, sc.settings.visibility_rays);
+    let nv = el.positions.len();
+    let fitted = Shooter::new(&sc, &el, &patches, &occ, 1.0);
+    let mut plain = Shooter::new(&sc, &el, &patches, &occ, 1.0);
+    plain.fit = false;
+    let lamp_patches: Vec<usize> = (0..patches.len())
+        .filter(|&p| patches[p].face == 0)
+        .collect();
+    assert!(!lamp_patches.is_empty());
+    for &p in &lamp_patches {
+        let (a, b) = (factors_of(&fitted, p, nv), factors_of(&plain, p, nv));
+        let largest = b.iter().fold(0.0f64, |m, &g| m.max(g));
+        assert!(largest > 0.0);
+        for (i, (x, y)) in a.iter().zip(&b).enumerate() {
+            // Twice the tolerance checked at the fit's four check points: the
+            // interpolant's largest miss elsewhere can be a little over what they see.
+            assert!(
+                (x - y).abs() <= 2.0 * fit::FIT_TOL * largest,
+                "vertex {i} at {}: fitted {x} vs {y}",
+                el.positions[i]
+            );
+        }
+    }
+    let used = fitted
+        .fitted_verts
+        .load(std::sync::atomic::Ordering::Relaxed);
+    assert!(
+        used * 2 > nv,
+        "the fit served {used} of {nv} vertex evaluations"
+    );
+    assert_eq!(
+        plain
+            .fitted_verts
+            .load(std::sync::atomic::Ordering::Relaxed),
+        0
+    );
 }

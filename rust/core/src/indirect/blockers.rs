@@ -1,0 +1,177 @@
+//! What could stand between a shooter and a receiver: per shooter face, the receiver faces
+//! something could be in front of (kept); per shot, the clipped shooter each receiver face
+//! sees; per vertex group, the faces the rays must be tested against.
+
+use std::sync::atomic::Ordering;
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::shooter::{Group, Shooter};
+use super::{FACE_OCCLUDER_BUDGET, MAX_FACE_OCCLUDERS, MAX_LISTED_OCCLUDERS};
+use crate::geom::polygon::clip_polygon_3d;
+use crate::geom::Plane;
+
+/// A receiver face and what could stand between it and a shooter face.
+pub(super) type Reached = (u32, FaceBlockers);
+
+pub(super) enum FaceBlockers {
+    Listed(Vec<u32>),
+    Many,
+}
+
+/// A receiver face in one shot: the shooter clipped to the face's front half-space, and
+/// which faces could block the rays between them.
+pub(super) struct Pair<'s> {
+    pub(super) face: u32,
+    pub(super) poly: Vec<DVec3>,
+    /// Bounds of `poly`.
+    pub(super) lo: DVec3,
+    pub(super) hi: DVec3,
+    /// A point of `poly`, for when no sample of the patch lies in front of the face.
+    pub(super) inner: DVec3,
+    /// `None`: nothing can block. `Some(Some(list))`: only these (for the whole face).
+    /// `Some(None)`: ask the BVH.
+    pub(super) known: Option<Option<&'s [u32]>>,
+}
+
+pub(super) enum Blockers {
+    None,
+    Listed(Vec<u32>),
+    Any,
+}
+
+impl Shooter<'_> {
+    /// The receivers of shots from face `fp` that something could stand in front of.
+    pub(super) fn face_blockers(&self, fp: u32) -> Option<&[Reached]> {
+        let cell = self.face_blockers[fp as usize].get_or_init(|| {
+            if self.kept.load(Ordering::Relaxed) > FACE_OCCLUDER_BUDGET {
+                return None;
+            }
+            let face = &self.scene.faces[fp as usize];
+            let found: Vec<Reached> = self
+                .receivers
+                .par_iter()
+                .filter_map(|&f| {
+                    let (lo, hi) = self.shaft(&face.verts, fp, &face.plane, f)?;
+                    let mut list = Vec::new();
+                    let planes = [face.plane, self.scene.faces[f as usize].plane];
+                    self.occ.candidates(lo, hi, &planes, &[fp, f], &mut list);
+                    match list.len() {
+                        0 => None,
+                        n if n <= MAX_FACE_OCCLUDERS => Some((f, FaceBlockers::Listed(list))),
+                        _ => Some((f, FaceBlockers::Many)),
+                    }
+                })
+                .collect();
+            let size = found.len()
+                + found
+                    .iter()
+                    .map(|(_, b)| match b {
+                        FaceBlockers::Listed(l) => l.len(),
+                        FaceBlockers::Many => 0,
+                    })
+                    .sum::<usize>();
+            self.kept.fetch_add(size, Ordering::Relaxed);
+            Some(found)
+        });
+        cell.as_deref()
+    }
+
+    /// Whether a shooter polygon `poly` on face `fp` (plane `plane`) can light receiver face
+    /// `f`, and then the box around the part of it in front of `f` and `f`.
+    pub(super) fn shaft(
+        &self,
+        poly: &[DVec3],
+        fp: u32,
+        plane: &Plane,
+        f: u32,
+    ) -> Option<(DVec3, DVec3)> {
+        if f == fp {
+            return None;
+        }
+        let face = &self.scene.faces[f as usize];
+        // The face's vertices lie in its polygon, so if its corners are all behind the
+        // shooter, so are they.
+        if face.verts.iter().all(|v| plane.dist(*v) <= self.tol) {
+            return None;
+        }
+        if poly.iter().all(|v| face.plane.dist(*v) <= self.tol) {
+            return None;
+        }
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        for v in poly.iter().chain(&face.verts) {
+            lo = lo.min(*v);
+            hi = hi.max(*v);
+        }
+        Some((lo, hi))
+    }
+
+    /// The shooter (patch polygon `poly` on face `fp`) as receiver face `f` sees it, or
+    /// `None` if no vertex of `f` can get light from it.
+    pub(super) fn pair<'s>(
+        &self,
+        poly: &[DVec3],
+        fp: u32,
+        plane: &Plane,
+        f: u32,
+        known: Option<&'s [Reached]>,
+    ) -> Option<Pair<'s>> {
+        self.shaft(poly, fp, plane, f)?;
+        let face = &self.scene.faces[f as usize];
+        let poly = clip_polygon_3d(poly, &face.plane, self.tol);
+        if poly.len() < 3 {
+            return None;
+        }
+        let inner = poly.iter().copied().sum::<DVec3>() / poly.len() as f64;
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        for v in &poly {
+            lo = lo.min(*v);
+            hi = hi.max(*v);
+        }
+        let known = match known.map(|k| k.binary_search_by_key(&f, |e| e.0).map(|i| &k[i].1)) {
+            Some(Err(_)) => None,
+            Some(Ok(FaceBlockers::Listed(l))) => Some(Some(&l[..])),
+            Some(Ok(FaceBlockers::Many)) | None => Some(None),
+        };
+        Some(Pair {
+            face: f,
+            poly,
+            lo,
+            hi,
+            inner,
+            known,
+        })
+    }
+
+    /// What could stand between the shooter and the vertices of `group`.
+    pub(super) fn blockers(&self, fp: u32, plane: &Plane, pair: &Pair, group: &Group) -> Blockers {
+        let Some(known) = pair.known else {
+            return Blockers::None;
+        };
+        let (lo, hi) = (pair.lo.min(group.lo), pair.hi.max(group.hi));
+        let mut list = Vec::new();
+        match known {
+            Some(l) => list.extend(
+                l.iter()
+                    .copied()
+                    .filter(|&o| self.occ.box_overlaps(o, lo, hi)),
+            ),
+            None => {
+                let planes = [*plane, self.scene.faces[pair.face as usize].plane];
+                self.occ
+                    .candidates(lo, hi, &planes, &[fp, pair.face], &mut list);
+            }
+        }
+        // A box test keeps a face that stands beside the shaft from the shooter to the
+        // group, or beyond it, as a floor does for everything on it; its plane tells.
+        list.retain(|&o| self.occ.straddled_by(o, &pair.poly, group.lo, group.hi));
+        match list.len() {
+            0 => Blockers::None,
+            n if n <= MAX_LISTED_OCCLUDERS => Blockers::Listed(list),
+            _ => Blockers::Any,
+        }
+    }
+}
