@@ -6,6 +6,7 @@
 
 pub mod arrangement;
 pub mod bake;
+pub mod covered;
 pub mod direct;
 pub mod edges;
 pub mod elements;
