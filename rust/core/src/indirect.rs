@@ -341,9 +341,10 @@ impl<'a> Shooter<'a> {
         let points = el
             .positions
             .iter()
-            .zip(&el.eval)
+            .enumerate()
             .zip(&el.vertex_face)
-            .map(|((x, e), &f)| {
+            .map(|((i, x), &f)| {
+                let e = el.eval.get(i).unwrap_or(x);
                 let d = centres[f as usize] - *x;
                 let l = d.length();
                 if !(l > 0.0) {
