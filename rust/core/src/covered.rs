@@ -54,7 +54,9 @@ pub fn open_parts(faces: &[Face], tol: f64) -> Vec<Vec<Open>> {
                 })
                 .filter(|c| signed_area_2d(c) > 0.0)
                 .collect();
-            covers.iter().fold(whole, |parts, c| subtract(parts, c, tol))
+            covers
+                .iter()
+                .fold(whole, |parts, c| subtract(parts, c, tol))
         })
         .collect()
 }
@@ -141,11 +143,17 @@ mod test {
         let q = floor.frame.to_2d(v(1.5, 1.5));
         let parts = open_parts(&[floor, bottom, lid], 1e-9);
         let area = |ps: &[Open]| ps.iter().map(|p| signed_area_2d(&p.poly)).sum::<f64>();
-        assert!((area(&parts[0]) - 15.0).abs() < 1e-12, "{}", area(&parts[0]));
+        assert!(
+            (area(&parts[0]) - 15.0).abs() < 1e-12,
+            "{}",
+            area(&parts[0])
+        );
         assert!(parts[1].is_empty());
         assert_eq!(parts[2].len(), 1);
         assert!(parts[2][0].cuts.is_empty());
         // The pieces' cuts keep a point under the box out of every piece.
-        assert!(parts[0].iter().all(|p| p.cuts.iter().any(|h| h.eval(q) < 0.0)));
+        assert!(parts[0]
+            .iter()
+            .all(|p| p.cuts.iter().any(|h| h.eval(q) < 0.0)));
     }
 }

@@ -22,6 +22,7 @@ pub mod relation;
 pub mod scene;
 pub mod settings;
 pub mod shadow;
+pub mod sizing;
 pub mod vertex_light;
 
 pub use bake::{bake, bake_scene_json, Bake, BakedMesh, Stats};
