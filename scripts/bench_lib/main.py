@@ -320,6 +320,8 @@ def main():
     ap.add_argument("--report-only", action="store_true",
                     help="rewrite the markdown and plots from OUT/results.json")
     ap.add_argument("--exe", default=os.path.join(ROOT, "target", "release", "penumbra"))
+    ap.add_argument("--no-scaling", action="store_true",
+                    help="skip the scaling series (room-N bakes of growing size)")
     a = ap.parse_args()
     if a.report_only:
         with open(os.path.join(a.out, "results.json")) as f:
@@ -339,7 +341,7 @@ def main():
                command="scripts/bench" + (" --quick" if a.quick else ""), scenes={})
     for name in a.scenes:
         bench_scene(name, a.exe, sys.executable, a.work, cfg, res["scenes"])
-    res["scaling"] = scaling(a.exe, a.work, cfg)
+    res["scaling"] = [] if a.no_scaling else scaling(a.exe, a.work, cfg)
     res["profile"] = profile(a.exe, a.work, a.scenes[-1])
     if "cornell" in a.scenes:
         res["render"] = render(a.exe, sys.executable, a.work, cfg)

@@ -16,6 +16,7 @@ use crate::geom::raycast::Occluders;
 use crate::indirect;
 use crate::mesh::{self, ReceiverMesh};
 use crate::regions::{self, ReceiverRegions, RegionTimes};
+use crate::sizing::Sizing;
 use crate::vertex_light;
 
 use crate::progress::Progress;
@@ -162,9 +163,11 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
     let meshes: Vec<ReceiverMesh> = regions
         .par_iter()
         .zip(&shadows)
-        .map(|(rr, sh)| {
+        .zip(&scene.faces)
+        .map(|((rr, sh), f)| {
             progress.check()?;
-            mesh::mesh_receiver(rr, sh, &scene.settings, diag, &budget)
+            let sizing = Sizing::new(f, &scene.lights, &scene.settings);
+            mesh::mesh_receiver(rr, sh, &sizing, &scene.settings, diag, &budget)
         })
         .collect::<Result<_, _>>()?;
     let elements = assemble(scene, &meshes);

@@ -89,8 +89,10 @@ pub fn indirect(
             format!("{} values for {nv} element vertices", direct.len()),
         ));
     }
+    let open = crate::covered::open_parts(&scene.faces, 1e-6 * scene.diagonal());
     let patches = build_patches(
         &scene.faces,
+        &open,
         el,
         settings.patch_size,
         settings.visibility_rays,

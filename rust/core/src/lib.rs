@@ -6,6 +6,7 @@
 
 pub mod arrangement;
 pub mod bake;
+pub mod covered;
 pub mod cuts;
 pub mod direct;
 pub mod edges;
@@ -23,6 +24,7 @@ pub mod scene;
 pub mod settings;
 pub mod screens;
 pub mod shadow;
+pub mod sizing;
 pub mod umbra_cover;
 pub mod vertex_light;
 

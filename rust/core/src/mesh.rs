@@ -1,7 +1,7 @@
 //! Stage 6 (paper 2.5): elements. Per receiver, a constrained Delaunay triangulation (spade)
 //! that conforms to every kept discontinuity edge and the receiver boundary. Nodes are seeded
-//! on a lattice whose spacing depends on the region (fine only in penumbra), then Delaunay
-//! refinement fixes angles. Edges across which some light jumps from lit to umbra (D0:
+//! on a lattice whose spacing depends on the region (fine in penumbra) and shrinks near the
+//! lights (`sizing`), then Delaunay refinement fixes angles. Edges across which some light jumps from lit to umbra (D0:
 //! contact shadows, point-light shadows) get two vertex rows, one per side.
 
 use std::collections::HashMap;
@@ -19,6 +19,7 @@ use crate::geom::polygon::orient;
 use crate::regions::{Indexed, ReceiverRegions, RegionFace};
 use crate::relation::Relation;
 use crate::settings::Settings;
+use crate::sizing::Sizing;
 use crate::BakeError;
 
 /// The element mesh of one receiver, in its 2-D frame.
@@ -42,6 +43,7 @@ type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
 pub fn mesh_receiver(
     rr: &ReceiverRegions,
     sh: &ReceiverShadows,
+    sizing: &Sizing,
     settings: &Settings,
     diag: f64,
     budget: &AtomicU64,
@@ -68,17 +70,21 @@ pub fn mesh_receiver(
         }
     }
 
-    // Seed nodes: a lattice per face, spaced by the face's relation.
-    let fine = settings.penumbra_element_size;
+    // Seed nodes: a lattice per face, spaced by the face's relation and the distance to the
+    // lights.
     let coarse = settings.element_size;
     let mut seeds = Vec::new();
     for (f, rf) in arr.faces.iter().zip(&rr.faces) {
-        let h = if !settings.uniform && rf.relations.iter().any(|r| *r == Relation::Penumbra) {
-            fine
-        } else {
-            coarse
+        let penumbra = !settings.uniform && rf.relations.iter().any(|r| *r == Relation::Penumbra);
+        let seen = |l: usize| rf.relations.get(l).is_some_and(|r| *r != Relation::Umbra);
+        let size = |p: DVec2, reach: f64| {
+            if penumbra {
+                sizing.penumbra(p, reach, &seen)
+            } else {
+                sizing.lit(p, reach, &seen)
+            }
         };
-        lattice_in_face(&arr.vertices, f, h, &mut seeds);
+        graded_lattice(&arr.vertices, f, &size, &mut seeds);
     }
     let used = budget.fetch_add(seeds.len() as u64 + handle.len() as u64, Ordering::Relaxed)
         + seeds.len() as u64;
@@ -95,6 +101,7 @@ pub fn mesh_receiver(
         let _ = cdt.insert(Point2::new(p.x, p.y));
     }
     let coarse_area = 0.433 * coarse * coarse;
+    let fine = sizing.smallest().min(settings.penumbra_element_size);
     let fine_area = 0.433 * fine * fine;
     let extra =
         (settings.max_elements.saturating_sub(used) as usize).min(cdt.num_vertices() * 4 + 64);
@@ -120,17 +127,70 @@ pub fn mesh_receiver(
     Ok(extract(&cdt, sh, false, diag))
 }
 
-/// Triangular lattice points strictly inside `f`, at least 0.35·h from its boundary.
-fn lattice_in_face(verts: &[DVec2], f: &ArrFace, h: f64, out: &mut Vec<DVec2>) {
+/// Lattice points in `f` whose spacing follows `size(p, reach)` (the size anywhere within
+/// `reach` of `p`; a negative reach asks for the largest size there): the face's bounds are
+/// split into blocks until the size varies little across each, then each block gets a
+/// lattice at its smallest size. Blocks of one size share one global lattice, so they
+/// join seamlessly; where sizes step, refinement mends the angles.
+fn graded_lattice(
+    verts: &[DVec2],
+    f: &ArrFace,
+    size: &dyn Fn(DVec2, f64) -> f64,
+    out: &mut Vec<DVec2>,
+) {
     let mut lo = DVec2::splat(f64::INFINITY);
     let mut hi = DVec2::splat(f64::NEG_INFINITY);
     for &v in &f.outer {
         lo = lo.min(verts[v as usize]);
         hi = hi.max(verts[v as usize]);
     }
+    if !(lo.x <= hi.x && lo.y <= hi.y) {
+        return;
+    }
+    let mut stack = vec![(lo, hi, 0u32)];
+    while let Some((blo, bhi, depth)) = stack.pop() {
+        let c = 0.5 * (blo + bhi);
+        let reach = 0.5 * (bhi - blo).length();
+        let small = size(c, reach);
+        let large = size(c, -reach);
+        let side = (bhi - blo).max_element();
+        if large <= 1.5 * small || side <= 4.0 * small || depth >= 12 {
+            lattice_in_face(verts, f, small, (blo, bhi), (lo, hi), out);
+            continue;
+        }
+        let m = c;
+        for (a, b) in [
+            (blo, m),
+            (DVec2::new(m.x, blo.y), DVec2::new(bhi.x, m.y)),
+            (DVec2::new(blo.x, m.y), DVec2::new(m.x, bhi.y)),
+            (m, bhi),
+        ] {
+            stack.push((a, b, depth + 1));
+        }
+    }
+}
+
+/// Triangular lattice points strictly inside `f` and in the block `[blo, bhi)` (closed on
+/// the sides where the block meets the face's bounds `outer`), at least 0.35·h from the
+/// face's boundary.
+fn lattice_in_face(
+    verts: &[DVec2],
+    f: &ArrFace,
+    h: f64,
+    (blo, bhi): (DVec2, DVec2),
+    outer: (DVec2, DVec2),
+    out: &mut Vec<DVec2>,
+) {
     if f.area < 0.2 * h * h {
         return;
     }
+    let (lo, hi) = (blo, bhi);
+    let in_block = |p: DVec2| {
+        p.x >= blo.x
+            && p.y >= blo.y
+            && (p.x < bhi.x || bhi.x >= outer.1.x)
+            && (p.y < bhi.y || bhi.y >= outer.1.y)
+    };
     let dy = h * 0.866_025_403_784_438_6;
     let j0 = (lo.y / dy).floor() as i64;
     let j1 = (hi.y / dy).ceil() as i64;
@@ -143,7 +203,7 @@ fn lattice_in_face(verts: &[DVec2], f: &ArrFace, h: f64, out: &mut Vec<DVec2>) {
         let off = if j.rem_euclid(2) == 1 { 0.5 * h } else { 0.0 };
         for i in i0..=i1 {
             let p = DVec2::new(i as f64 * h + off, y);
-            if p.x < lo.x || p.x > hi.x || p.y < lo.y || p.y > hi.y {
+            if p.x < lo.x || p.x > hi.x || p.y < lo.y || p.y > hi.y || !in_block(p) {
                 continue;
             }
             if winding(verts, &f.outer, p) == 0

@@ -1,10 +1,13 @@
 //! Patches: the coarse partition of each receiver face that shoots indirect light (paper
 //! §2.6; elements receive, patches shoot). A face's convex polygon is cut by a square grid
 //! in its frame; a patch's radiosity is the area-weighted mean of the element triangles
-//! overlapping it (a triangle's value being the mean of its three vertices).
+//! overlapping it (a triangle's value being the mean of its three vertices). Parts of a face
+//! covered by another face lying against it (`covered`) belong to no patch: a cell they cut
+//! splits into convex pieces, each its own patch.
 
 use glam::{DVec2, DVec3};
 
+use crate::covered::Open;
 use crate::elements::Elements;
 use crate::geom::polygon::{
     clip_polygon_2d, signed_area_2d, simplify_convex, strictly_inside_convex, HalfPlane,
@@ -35,10 +38,20 @@ pub struct Patch {
 /// An element triangle counts in every patch it overlaps, by the area of the overlap (not
 /// only in the one holding its centroid): so each patch's element area is its own area, and
 /// a cell no centroid falls in (elements as large as patches) is still there to shoot.
-pub fn build_patches(faces: &[Face], el: &Elements, patch_size: f64, rays: u32) -> Vec<Patch> {
+///
+/// `open` is each face's uncovered part (`covered::open_parts`); triangles under a cover
+/// weigh in no patch.
+pub fn build_patches(
+    faces: &[Face],
+    open: &[Vec<Open>],
+    el: &Elements,
+    patch_size: f64,
+    rays: u32,
+) -> Vec<Patch> {
     struct Piece {
         face: u32,
         cell: (u64, u64),
+        part: u32,
         tri: u32,
         area: f64,
     }
@@ -56,32 +69,56 @@ pub fn build_patches(faces: &[Face], el: &Elements, patch_size: f64, rays: u32) 
         }
         let lo = grid.cell(q[0].min(q[1]).min(q[2]));
         let hi = grid.cell(q[0].max(q[1]).max(q[2]));
-        let before = pieces.len();
+        let parts = &open[face as usize];
+        let (tlo, thi) = bounds(&q);
+        let mut overlaps = false;
         for j in lo.1..=hi.1 {
             for i in lo.0..=hi.0 {
-                let area = signed_area_2d(&grid.clip(&q, (i, j)));
-                if area > 0.0 {
-                    pieces.push(Piece {
-                        face,
-                        cell: (i, j),
-                        tri: t as u32,
-                        area,
-                    });
+                let in_cell = grid.clip(&q, (i, j));
+                if !(signed_area_2d(&in_cell) > 0.0) {
+                    continue;
+                }
+                overlaps = true;
+                for (k, part) in parts.iter().enumerate() {
+                    let area = if part.cuts.is_empty() {
+                        signed_area_2d(&in_cell)
+                    } else {
+                        let (plo, phi) = bounds(&part.poly);
+                        if plo.x > thi.x || plo.y > thi.y || phi.x < tlo.x || phi.y < tlo.y {
+                            continue;
+                        }
+                        let p = part
+                            .cuts
+                            .iter()
+                            .fold(in_cell.clone(), |p, h| clip_polygon_2d(&p, h, 0.0));
+                        signed_area_2d(&p)
+                    };
+                    if area > 0.0 {
+                        pieces.push(Piece {
+                            face,
+                            cell: (i, j),
+                            part: k as u32,
+                            tri: t as u32,
+                            area,
+                        });
+                    }
                 }
             }
         }
-        // A degenerate triangle still carries its vertices' values into some patch.
-        if pieces.len() == before {
+        // A degenerate triangle still carries its vertices' values into some patch (one
+        // wholly under a cover into none).
+        if !overlaps && !parts.is_empty() {
             let cell = grid.cell((q[0] + q[1] + q[2]) / 3.0);
             pieces.push(Piece {
                 face,
                 cell,
+                part: 0,
                 tri: t as u32,
                 area: 0.0,
             });
         }
     }
-    pieces.sort_by_key(|p| (p.face, p.cell.1, p.cell.0, p.tri));
+    pieces.sort_by_key(|p| (p.face, p.cell.1, p.cell.0, p.part, p.tri));
 
     let mut patches = Vec::new();
     let mut start = 0;
@@ -95,18 +132,26 @@ pub fn build_patches(faces: &[Face], el: &Elements, patch_size: f64, rays: u32) 
         // element poking out of the face by rounding) hands its pieces to the nearest.
         let f = &faces[face as usize];
         let grid = &grids[face as usize];
-        // (cell, the face within it, (triangle, overlap area) pairs)
-        type Cell = ((u64, u64), Vec<DVec2>, Vec<(u32, f64)>);
+        // (cell and part, the face within it, (triangle, overlap area) pairs)
+        type Cell = ((u64, u64, u32), Vec<DVec2>, Vec<(u32, f64)>);
         let mut cells: Vec<Cell> = Vec::new();
-        let mut orphans: Vec<((u64, u64), (u32, f64))> = Vec::new();
+        let mut orphans: Vec<((u64, u64, u32), (u32, f64))> = Vec::new();
         let mut i = start;
         while i < end {
-            let cell = pieces[i].cell;
+            let cell = (pieces[i].cell.0, pieces[i].cell.1, pieces[i].part);
             let mut j = i;
-            while j < end && pieces[j].cell == cell {
+            while j < end && (pieces[j].cell.0, pieces[j].cell.1, pieces[j].part) == cell {
                 j += 1;
             }
-            let poly = grid.clip(&f.poly2, cell);
+            let part = &open[face as usize][cell.2 as usize];
+            let poly = simplify_convex(
+                &part
+                    .cuts
+                    .iter()
+                    .fold(grid.clip(&f.poly2, (cell.0, cell.1)), |p, h| {
+                        clip_polygon_2d(&p, h, 0.0)
+                    }),
+            );
             let members = pieces[i..j].iter().map(|p| (p.tri, p.area));
             if poly.len() >= 3 && signed_area_2d(&poly) > 0.0 {
                 cells.push((cell, poly, members.collect()));
@@ -116,17 +161,20 @@ pub fn build_patches(faces: &[Face], el: &Elements, patch_size: f64, rays: u32) 
             i = j;
         }
         if cells.is_empty() {
-            cells.push(((0, 0), f.poly2.clone(), Vec::new()));
+            let poly = open[face as usize]
+                .first()
+                .map_or_else(|| f.poly2.clone(), |p| p.poly.clone());
+            cells.push(((0, 0, 0), poly, Vec::new()));
         }
         for (cell, m) in orphans {
-            let dist = |c: (u64, u64)| c.0.abs_diff(cell.0).max(c.1.abs_diff(cell.1));
+            let dist = |c: (u64, u64, u32)| c.0.abs_diff(cell.0).max(c.1.abs_diff(cell.1));
             let k = (0..cells.len())
                 .min_by_key(|&k| dist(cells[k].0))
                 .unwrap_or(0);
             cells[k].2.push(m);
         }
         for (cell, poly2, members) in cells {
-            let seed = (face as u64) << 40 ^ cell.1 << 20 ^ cell.0;
+            let seed = (cell.2 as u64) << 60 ^ (face as u64) << 40 ^ cell.1 << 20 ^ cell.0;
             patches.push(patch(face, f, &poly2, &members, el, rays, seed));
         }
         start = end;
@@ -279,6 +327,13 @@ fn patch(
     }
 }
 
+fn bounds(poly: &[DVec2]) -> (DVec2, DVec2) {
+    poly.iter().fold(
+        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    )
+}
+
 fn centroid_2d(poly: &[DVec2]) -> DVec2 {
     let n = poly.len();
     let o = poly[0];
@@ -409,6 +464,10 @@ pub(crate) mod test {
         el
     }
 
+    fn open_of(f: &Face) -> Vec<Vec<Open>> {
+        crate::covered::open_parts(std::slice::from_ref(f), 1e-9)
+    }
+
     fn square(s: f64) -> Face {
         let v = |x, y| DVec3::new(x, y, 0.0);
         face(
@@ -439,7 +498,7 @@ pub(crate) mod test {
         let f = square(2.0);
         let el = grid_elements(std::slice::from_ref(&f), 8);
         // 2 / 0.7 → 3 cells a side of 2/3.
-        let p = build_patches(&[f], &el, 0.7, 16);
+        let p = build_patches(std::slice::from_ref(&f), &open_of(&f), &el, 0.7, 16);
         assert_eq!(p.len(), 9);
         let total: f64 = p.iter().map(|p| p.area).sum();
         assert!((total - 4.0).abs() < 1e-12);
@@ -464,6 +523,30 @@ pub(crate) mod test {
     }
 
     #[test]
+    fn floor_under_a_box_is_in_no_patch() {
+        let v = |x, y| DVec3::new(x, y, 0.0);
+        let floor = square(4.0);
+        // A box bottom facing down, 1 × 1 at (1.5, 1.5): it straddles four cells.
+        let bottom = face(
+            &[v(1.5, 1.5), v(1.5, 2.5), v(2.5, 2.5), v(2.5, 1.5)],
+            DVec3::ONE,
+            DVec3::ZERO,
+        );
+        let faces = [floor, bottom];
+        let open = crate::covered::open_parts(&faces, 1e-9);
+        let el = grid_elements(&faces, 8);
+        let p = build_patches(&faces, &open, &el, 2.0, 16);
+        assert!(p.iter().all(|q| q.face == 0));
+        let total: f64 = p.iter().map(|q| q.area).sum();
+        assert!((total - 15.0).abs() < 1e-9, "{total}");
+        let under = faces[0].frame.to_2d(v(2.0, 2.0));
+        for q in &p {
+            let poly: Vec<DVec2> = q.poly.iter().map(|x| faces[0].frame.to_2d(*x)).collect();
+            assert!(!strictly_inside_convex(&poly, under));
+        }
+    }
+
+    #[test]
     fn triangle_face_cells_are_clipped_and_samples_inside() {
         let v = |x, y| DVec3::new(x, y, 1.0);
         let f = face(
@@ -472,7 +555,7 @@ pub(crate) mod test {
             DVec3::ZERO,
         );
         let el = grid_elements(std::slice::from_ref(&f), 12);
-        let p = build_patches(std::slice::from_ref(&f), &el, 1.0, 9);
+        let p = build_patches(std::slice::from_ref(&f), &open_of(&f), &el, 1.0, 9);
         let total: f64 = p.iter().map(|p| p.area).sum();
         assert!((total - 4.5).abs() < 1e-12);
         // Every patch holds elements; samples lie inside the face and on its plane.

@@ -148,17 +148,27 @@ impl<'a> Shooter<'a> {
             .iter()
             .map(|f| f.verts.iter().copied().sum::<DVec3>() / f.verts.len().max(1) as f64)
             .collect();
+        // A vertex on a D0 row (the floor along a box's foot) has a copy per side, and its
+        // evaluation point a hair into its own side: the nudge must go that way, not to the
+        // face's centre, which may lie under the box (all light blocked there).
         let points = el
             .positions
             .iter()
+            .enumerate()
             .zip(&el.vertex_face)
-            .map(|(x, &f)| {
+            .map(|((i, x), &f)| {
+                let e = el.eval.get(i).unwrap_or(x);
                 let d = centres[f as usize] - *x;
                 let l = d.length();
-                if l > 0.0 {
-                    *x + d * (1e-6f64).max(100.0 * tol / l).min(0.5)
+                if !(l > 0.0) {
+                    return *x;
+                }
+                let step = (1e-6 * l).max(100.0 * tol).min(0.5 * l);
+                let side = *e - *x;
+                if side.length() > 0.0 {
+                    *x + side.normalize() * step
                 } else {
-                    *x
+                    *x + d * (step / l)
                 }
             })
             .collect();

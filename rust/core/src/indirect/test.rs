@@ -570,7 +570,8 @@ fn fitted_far_groups_agree_with_vertex_by_vertex() {
     let sc = scene(vec![lamp, floor, panel], |s| s.patch_size = 0.5);
     let el = grid_elements(&sc.faces, 40);
     let occ = Occluders::new(&sc.faces);
-    let patches = build_patches(&sc.faces, &el, 0.5, sc.settings.visibility_rays);
+    let open = crate::covered::open_parts(&sc.faces, 1e-6 * sc.diagonal());
+    let patches = build_patches(&sc.faces, &open, &el, 0.5, sc.settings.visibility_rays);
     let nv = el.positions.len();
     let fitted = Shooter::new(&sc, &el, &patches, &occ, 1.0);
     let mut plain = Shooter::new(&sc, &el, &patches, &occ, 1.0);
