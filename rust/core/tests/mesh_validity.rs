@@ -1,6 +1,7 @@
 //! Validity of the output mesh on many random scenes (boxes and tilted quads over a floor,
-//! sunk into it, crossing each other or resting on it; area and point lights; scene sizes
-//! from 1e-3 to 1e3): every triangle faces the way its source polygon does, has a real
+//! sunk into it, crossing each other or resting on it; L-shaped floors and floors with a
+//! dented side; area and point lights; scene sizes from 1e-3 to 1e3, some far from the
+//! origin): every triangle faces the way its source polygon does, has a real
 //! area, lies in that polygon's plane and inside it; the triangles of a polygon cover exactly
 //! its area; indices, relation codes and colours are well formed.
 
@@ -201,21 +202,26 @@ fn turned_box(c: DVec3, h: [f64; 3], axis: DVec3, angle: f64) -> Vec<Vec<[f64; 3
         .collect()
 }
 
-fn scaled(mut m: MeshJson, k: f64) -> MeshJson {
+/// `p` scaled by `k` and then moved by `off` (in units of the scaled scene).
+fn place(p: [f64; 3], k: f64, off: DVec3) -> [f64; 3] {
+    ((DVec3::from_array(p) + off) * k).to_array()
+}
+
+fn moved(mut m: MeshJson, k: f64, off: DVec3) -> MeshJson {
     for p in &mut m.positions {
-        *p = p.map(|x| x * k);
+        *p = place(*p, k, off);
     }
     m
 }
 
-fn scaled_light(mut l: LightJson, k: f64) -> LightJson {
+fn moved_light(mut l: LightJson, k: f64, off: DVec3) -> LightJson {
     if let Some(p) = &mut l.polygon {
         for q in p {
-            *q = q.map(|x| x * k);
+            *q = place(*q, k, off);
         }
     }
     if let Some(p) = &mut l.point {
-        *p = p.map(|x| x * k);
+        *p = place(*p, k, off);
     }
     // Point intensity falls off with distance squared: keep the picture the same.
     if let Some(i) = &mut l.intensity {
@@ -229,7 +235,28 @@ fn scaled_light(mut l: LightJson, k: f64) -> LightJson {
 fn random_scene(seed: u64) -> SceneJson {
     let mut rng = Rng(seed.wrapping_mul(0x2545_F491_4F6C_DD1D));
     let k = 10f64.powi((rng.next() * 7.0) as i32 - 3);
-    let mut meshes = vec![mesh("Floor", vec![quad([0., 0., 0.], 1.0, 1.0, true)])];
+    let floor = match (rng.next() * 3.0) as usize {
+        0 => quad([0., 0., 0.], 1.0, 1.0, true),
+        // Not convex: an L.
+        1 => vec![
+            [-1., -1., 0.],
+            [1., -1., 0.],
+            [1., 0.2, 0.],
+            [0.1, 0.2, 0.],
+            [0.1, 1., 0.],
+            [-1., 1., 0.],
+        ],
+        // A vertex in the middle of a side and one a hair off the side's line.
+        _ => vec![
+            [-1., -1., 0.],
+            [0., -1., 0.],
+            [1., -1., 0.],
+            [1., 1., 0.],
+            [0.0, 1.0 + 1e-10, 0.],
+            [-1., 1., 0.],
+        ],
+    };
+    let mut meshes = vec![mesh("Floor", vec![floor])];
     let n_box = (rng.next() * 3.0) as usize;
     for b in 0..n_box {
         let h = [
@@ -300,9 +327,19 @@ fn random_scene(seed: u64) -> SceneJson {
         ));
     }
     let indirect = rng.next() < 0.25;
+    // Some scenes sit far from the origin: coordinates then carry fewer digits of the scene.
+    let off = if rng.next() < 0.3 {
+        DVec3::new(
+            rng.range(-50., 50.),
+            rng.range(-50., 50.),
+            rng.range(-50., 50.),
+        )
+    } else {
+        DVec3::ZERO
+    };
     scene(
-        meshes.into_iter().map(|m| scaled(m, k)).collect(),
-        lights.into_iter().map(|l| scaled_light(l, k)).collect(),
+        meshes.into_iter().map(|m| moved(m, k, off)).collect(),
+        lights.into_iter().map(|l| moved_light(l, k, off)).collect(),
         settings(k, indirect),
     )
 }
@@ -345,12 +382,13 @@ fn slab_crossing_the_floor_gives_a_valid_mesh() {
     }
 }
 
+/// MESH_VALIDITY_FIRST and MESH_VALIDITY_SEEDS choose other seeds (e.g. 1 and 400).
 #[test]
 fn random_scenes_give_valid_meshes() {
     let seeds: u64 = std::env::var("MESH_VALIDITY_SEEDS")
         .ok()
         .and_then(|s| s.parse().ok())
-        .unwrap_or(40);
+        .unwrap_or(200);
     let (mut tris, mut tiny) = (0, 0);
     let first: u64 = std::env::var("MESH_VALIDITY_FIRST")
         .ok()
@@ -365,4 +403,8 @@ fn random_scenes_give_valid_meshes() {
     }
     eprintln!("{tris} triangles, {tiny} of area below 1e-12 of size²");
     assert!(tris > 1000, "{tris} triangles checked");
+    // Tiny but not flat triangles fill tiny faces of the arrangement (lines that nearly
+    // meet, the 1e-10 dent in a floor's side): they are needed to cover the polygon, and
+    // almost all are at least 1e-9 of the scene high. They must stay rare.
+    assert!(tiny * 100 <= tris, "{tiny} of {tris} triangles are tiny");
 }
