@@ -408,3 +408,18 @@ fn random_scenes_give_valid_meshes() {
     // almost all are at least 1e-9 of the scene high. They must stay rare.
     assert!(tiny * 100 <= tris, "{tiny} of {tris} triangles are tiny");
 }
+
+/// Checks the bake of the scene JSON files listed (colon-separated) in MESH_VALIDITY_SCENES,
+/// e.g. built-in scenes written by `penumbra scene NAME -o FILE`.
+#[test]
+#[ignore]
+fn scene_files_give_valid_meshes() {
+    let list = std::env::var("MESH_VALIDITY_SCENES").expect("MESH_VALIDITY_SCENES");
+    for path in list.split(':') {
+        let text = std::fs::read_to_string(path).expect("readable scene");
+        let s = SceneJson::from_str(&text).expect("scene JSON");
+        let mut tiny = 0;
+        let n = check_mesh_validity(&s, &bake(&s), path, &mut tiny);
+        eprintln!("{path}: {n} triangles, {tiny} tiny");
+    }
+}
