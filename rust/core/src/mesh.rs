@@ -275,12 +275,13 @@ fn extract(cdt: &Cdt, sh: &ReceiverShadows, uniform: bool, diag: f64) -> Receive
 
     // Components across unconstrained edges.
     if uniform {
-        let n = triangles.len();
+        let mut tri_region = vec![0; triangles.len()];
+        drop_flat(&positions, &mut triangles, &mut tri_region, diag);
         return ReceiverMesh {
             eval: positions.clone(),
             positions,
             triangles,
-            tri_region: vec![0; n],
+            tri_region,
             regions: Vec::new(),
         };
     }
@@ -450,11 +451,52 @@ fn extract(cdt: &Cdt, sh: &ReceiverShadows, uniform: bool, diag: f64) -> Receive
         }
     }
     let _ = nv;
+    let mut tri_region = comp;
+    drop_flat(&positions, &mut triangles, &mut tri_region, diag);
     ReceiverMesh {
         positions,
         eval,
         triangles,
-        tri_region: comp,
+        tri_region,
         regions,
     }
+}
+
+/// Removes triangles narrower than 1e-12 of the scene size (twice the area over the longest
+/// side). Spade splits constraint edges at computed points (midpoints when refining) that
+/// lie an ulp or so off the exact line; its exact predicates then see a kink there, keep
+/// triangles spanned by three points of one line (e.g. filling the dent the kink makes in
+/// the hull), and refinement near a kink can run away, halving ever thinner triangles. Such
+/// a triangle is a thousand times narrower than the distance below which the arrangement
+/// merges points (~1e-9 of the scene), so it stands for no discontinuity; it carries no
+/// light (area under 1e-12 × scene × its length), and its facing is decided by rounding,
+/// so in 3-D it may point against its polygon. Dropping it leaves a slit of that width. It
+/// is done after the D0 split so that, while sectors and regions are formed, it still joins
+/// its neighbours.
+fn drop_flat(
+    positions: &[DVec2],
+    triangles: &mut Vec<[u32; 3]>,
+    tri_region: &mut Vec<u32>,
+    diag: f64,
+) {
+    let scale = positions
+        .iter()
+        .fold(0.0f64, |m, p| m.max(p.abs().max_element()));
+    // Rounding alone moves a point off a line by a few ulps of the coordinates.
+    let tol = (64.0 * f64::EPSILON * scale).max(1e-12 * diag);
+    let keep: Vec<bool> = triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| positions[i as usize]);
+            let longest = (b - a).length().max((c - b).length()).max((a - c).length());
+            (b - a).perp_dot(c - a).abs() > tol * longest
+        })
+        .collect();
+    if keep.iter().all(|&k| k) {
+        return;
+    }
+    let mut k = keep.iter();
+    triangles.retain(|_| *k.next().unwrap_or(&true));
+    let mut k = keep.iter();
+    tri_region.retain(|_| *k.next().unwrap_or(&true));
 }
