@@ -73,16 +73,18 @@ pub fn mesh_receiver(
     // Seed nodes: a lattice per face, spaced by the face's relation and the distance to the
     // lights.
     let coarse = settings.element_size;
+    let corners = Corners::new(sh, coarse);
     let mut seeds = Vec::new();
     for (f, rf) in arr.faces.iter().zip(&rr.faces) {
         let penumbra = !settings.uniform && rf.relations.iter().any(|r| *r == Relation::Penumbra);
         let seen = |l: usize| rf.relations.get(l).is_some_and(|r| *r != Relation::Umbra);
         let size = |p: DVec2, reach: f64| {
-            if penumbra {
+            let s = if penumbra {
                 sizing.penumbra(p, reach, &seen)
             } else {
                 sizing.lit(p, reach, &seen)
-            }
+            };
+            corners.cap(s, p, reach)
         };
         graded_lattice(&arr.vertices, f, &size, &mut seeds);
     }
@@ -101,7 +103,10 @@ pub fn mesh_receiver(
         let _ = cdt.insert(Point2::new(p.x, p.y));
     }
     let coarse_area = 0.433 * coarse * coarse;
-    let fine = sizing.smallest().min(settings.penumbra_element_size);
+    let fine = sizing
+        .smallest()
+        .min(settings.penumbra_element_size)
+        .min(corners.smallest());
     let fine_area = 0.433 * fine * fine;
     let extra =
         (settings.max_elements.saturating_sub(used) as usize).min(cdt.num_vertices() * 4 + 64);
@@ -125,6 +130,61 @@ pub fn mesh_receiver(
         return Ok(m);
     }
     Ok(extract(&cdt, sh, false, diag))
+}
+
+/// Ends of D0 lines (the feet of a box on the floor, where a solid passes through): there
+/// the light depends on the direction one comes from, not on the distance, so no linear
+/// element that touches such a point is right, however small. Elements shrink towards them
+/// in proportion to the distance, which keeps each element's angular span, and with it the
+/// interpolation error, bounded, and leaves the wrong values at the corner itself only a
+/// tiny area.
+struct Corners {
+    points: Vec<DVec2>,
+    floor: f64,
+}
+
+/// Element size at most this fraction of the distance to a corner.
+const PER_CORNER_DISTANCE: f64 = 0.7;
+/// ... and never below this fraction of `element_size`.
+const CORNER_FLOOR: f64 = 1.0 / 16.0;
+
+impl Corners {
+    fn new(sh: &ReceiverShadows, coarse: f64) -> Self {
+        let mut points: Vec<DVec2> = sh
+            .contacts
+            .iter()
+            .chain(&sh.plane_cuts)
+            .flat_map(|[a, b]| [*a, *b])
+            .collect();
+        points.sort_unstable_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+        points.dedup();
+        Corners {
+            points,
+            floor: coarse * CORNER_FLOOR,
+        }
+    }
+
+    /// `size` capped near corners, for anywhere within `reach` of `p` (a negative reach: the
+    /// largest cap there).
+    fn cap(&self, size: f64, p: DVec2, reach: f64) -> f64 {
+        let near = self
+            .points
+            .iter()
+            .map(|c| (*c - p).length())
+            .fold(f64::INFINITY, f64::min);
+        if !near.is_finite() {
+            return size;
+        }
+        size.min(((near - reach).max(0.0) * PER_CORNER_DISTANCE).max(self.floor))
+    }
+
+    fn smallest(&self) -> f64 {
+        if self.points.is_empty() {
+            f64::INFINITY
+        } else {
+            self.floor
+        }
+    }
 }
 
 /// Lattice points in `f` whose spacing follows `size(p, reach)` (the size anywhere within
