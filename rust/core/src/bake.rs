@@ -305,14 +305,14 @@ fn output(scene: &Scene, el: &Elements, colors: &[[f64; 3]]) -> Vec<BakedMesh> {
     for (t, tri) in el.triangles.iter().enumerate() {
         let f = &scene.faces[el.tri_face[t] as usize];
         let m = &mut out[f.mesh as usize];
+        let c = tri.map(|v| canon[v as usize]);
+        // Two corners welded into one (a triangle under the weld distance, 1e-9 of the
+        // scene): nothing left to draw, and its facing would be rounding.
+        if c[0] == c[1] || c[1] == c[2] || c[0] == c[2] {
+            continue;
+        }
         let mut idx = [0u32; 3];
-        for (k, &v) in tri
-            .iter()
-            .map(|&v| canon[v as usize])
-            .collect::<Vec<_>>()
-            .iter()
-            .enumerate()
-        {
+        for (k, &v) in c.iter().enumerate() {
             if remap[v as usize] == u32::MAX {
                 remap[v as usize] = m.positions.len() as u32;
                 m.positions.push(el.positions[v as usize].to_array());

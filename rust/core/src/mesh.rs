@@ -7,7 +7,9 @@
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use glam::DVec2;
+use glam::{DVec2, DVec3};
+
+use crate::geom::Frame;
 use spade::handles::FixedVertexHandle;
 use spade::{
     AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation,
@@ -122,14 +124,14 @@ pub fn mesh_receiver(
         Ordering::Relaxed,
     );
     if settings.uniform {
-        let mut m = extract(&cdt, sh, true, diag);
+        let mut m = extract(&cdt, sh, sizing.frame(), true, diag);
         m.regions = vec![rr.faces.first().cloned().unwrap_or(RegionFace {
             relations: Vec::new(),
             blockers: Vec::new(),
         })];
         return Ok(m);
     }
-    Ok(extract(&cdt, sh, false, diag))
+    Ok(extract(&cdt, sh, sizing.frame(), false, diag))
 }
 
 /// Ends of D0 lines (the feet of a box on the floor, where a solid passes through): there
@@ -316,7 +318,13 @@ fn seg_dist(a: DVec2, b: DVec2, p: DVec2) -> f64 {
 
 /// Triangles, their regions (connected components across non-constraint edges, classified
 /// once each), and the D0 vertex split.
-fn extract(cdt: &Cdt, sh: &ReceiverShadows, uniform: bool, diag: f64) -> ReceiverMesh {
+fn extract(
+    cdt: &Cdt,
+    sh: &ReceiverShadows,
+    frame: &Frame,
+    uniform: bool,
+    diag: f64,
+) -> ReceiverMesh {
     let nv = cdt.num_vertices();
     let mut positions: Vec<DVec2> = cdt
         .vertices()
@@ -336,7 +344,7 @@ fn extract(cdt: &Cdt, sh: &ReceiverShadows, uniform: bool, diag: f64) -> Receive
     // Components across unconstrained edges.
     if uniform {
         let mut tri_region = vec![0; triangles.len()];
-        drop_flat(&positions, &mut triangles, &mut tri_region, diag);
+        drop_flat(&positions, frame, &mut triangles, &mut tri_region, diag);
         return ReceiverMesh {
             eval: positions.clone(),
             positions,
@@ -512,7 +520,7 @@ fn extract(cdt: &Cdt, sh: &ReceiverShadows, uniform: bool, diag: f64) -> Receive
     }
     let _ = nv;
     let mut tri_region = comp;
-    drop_flat(&positions, &mut triangles, &mut tri_region, diag);
+    drop_flat(&positions, frame, &mut triangles, &mut tri_region, diag);
     ReceiverMesh {
         positions,
         eval,
@@ -535,21 +543,23 @@ fn extract(cdt: &Cdt, sh: &ReceiverShadows, uniform: bool, diag: f64) -> Receive
 /// its neighbours.
 fn drop_flat(
     positions: &[DVec2],
+    frame: &Frame,
     triangles: &mut Vec<[u32; 3]>,
     tri_region: &mut Vec<u32>,
     diag: f64,
 ) {
-    let scale = positions
-        .iter()
-        .fold(0.0f64, |m, p| m.max(p.abs().max_element()));
+    // Judged in 3-D: far from the origin, points apart in the receiver's frame can round
+    // to one point in the scene.
+    let p3: Vec<DVec3> = positions.iter().map(|p| frame.to_3d(*p)).collect();
+    let scale = p3.iter().fold(0.0f64, |m, p| m.max(p.abs().max_element()));
     // Rounding alone moves a point off a line by a few ulps of the coordinates.
     let tol = (64.0 * f64::EPSILON * scale).max(1e-12 * diag);
     let keep: Vec<bool> = triangles
         .iter()
         .map(|t| {
-            let [a, b, c] = t.map(|i| positions[i as usize]);
+            let [a, b, c] = t.map(|i| p3[i as usize]);
             let longest = (b - a).length().max((c - b).length()).max((a - c).length());
-            (b - a).perp_dot(c - a).abs() > tol * longest
+            (b - a).cross(c - a).length() > tol * longest
         })
         .collect();
     if keep.iter().all(|&k| k) {

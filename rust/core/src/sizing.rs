@@ -105,6 +105,11 @@ impl Sizing {
             .max(self.coarse * PENUMBRA_FLOOR)
     }
 
+    /// The receiver's frame.
+    pub fn frame(&self) -> &crate::geom::Frame {
+        &self.frame
+    }
+
     /// The smallest size this receiver can ask for.
     pub fn smallest(&self) -> f64 {
         let lit = if self.sources.is_empty() {
