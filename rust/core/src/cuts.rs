@@ -46,37 +46,11 @@ pub fn plane_cut(verts: &[DVec3], r: &Face, touch: f64) -> Option<[DVec2; 2]> {
     clip_segment_convex(r.frame.to_2d(a), r.frame.to_2d(b), &r.poly2, touch)
 }
 
-/// The part of segment a–b inside the counter-clockwise convex polygon `poly` (Cyrus–Beck),
-/// or `None` when less than `tol` of it is left.
+/// The part of segment a–b inside the counter-clockwise convex polygon `poly`, or `None`
+/// when less than `tol` of it is left.
 fn clip_segment_convex(a: DVec2, b: DVec2, poly: &[DVec2], tol: f64) -> Option<[DVec2; 2]> {
-    let (mut t0, mut t1) = (0.0f64, 1.0f64);
     let d = b - a;
-    for i in 0..poly.len() {
-        let p = poly[i];
-        let e = poly[(i + 1) % poly.len()] - p;
-        let len = e.length();
-        if !(len > 0.0) {
-            continue;
-        }
-        // Signed distance inside (left of the edge) at a, and its rate along the segment.
-        let fa = e.perp_dot(a - p) / len;
-        let fd = e.perp_dot(d) / len;
-        if fd.abs() < 1e-300 {
-            if fa < 0.0 {
-                return None;
-            }
-            continue;
-        }
-        let t = -fa / fd;
-        if fd > 0.0 {
-            t0 = t0.max(t);
-        } else {
-            t1 = t1.min(t);
-        }
-        if t0 >= t1 {
-            return None;
-        }
-    }
+    let (t0, t1) = crate::geom::polygon::clip_segment_convex(a, b, poly)?;
     ((t1 - t0) * d.length() > tol).then(|| [a + d * t0, a + d * t1])
 }
 

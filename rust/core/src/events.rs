@@ -43,33 +43,10 @@ fn clip_height(r: &Face, a: DVec3, b: DVec3, limit: f64) -> Option<(DVec3, DVec3
     (t1 > t0).then(|| (a + (b - a) * t0, a + (b - a) * t1))
 }
 
-/// Clips a 2-D segment to a convex counter-clockwise polygon (Cyrus–Beck).
+/// Clips a 2-D segment to a convex counter-clockwise polygon.
 fn clip_to_convex(p: DVec2, q: DVec2, poly: &[DVec2]) -> Option<(DVec2, DVec2)> {
-    let (mut t0, mut t1) = (0.0f64, 1.0f64);
-    let d = q - p;
-    for i in 0..poly.len() {
-        let a = poly[i];
-        let e = poly[(i + 1) % poly.len()] - a;
-        // Inside is to the left of e: cross(e, x - a) ≥ 0.
-        let f0 = e.perp_dot(p - a);
-        let fd = e.perp_dot(d);
-        if fd == 0.0 {
-            if f0 < 0.0 {
-                return None;
-            }
-            continue;
-        }
-        let t = -f0 / fd;
-        if fd > 0.0 {
-            t0 = t0.max(t);
-        } else {
-            t1 = t1.min(t);
-        }
-        if t0 >= t1 {
-            return None;
-        }
-    }
-    Some((p + d * t0, p + d * t1))
+    let (t0, t1) = crate::geom::polygon::clip_segment_convex(p, q, poly)?;
+    Some((p + (q - p) * t0, p + (q - p) * t1))
 }
 
 /// VE and EV segments of light `lv` (an area light's polygon, clipped to the receiver's front)

@@ -151,6 +151,39 @@ pub fn simplify_convex(poly: &[DVec2]) -> Vec<DVec2> {
     pts
 }
 
+/// The parameters `t0 < t1` along a–b (0 at a, 1 at b) of the part of segment a–b inside
+/// the counter-clockwise convex polygon `poly` (Cyrus–Beck), or `None` when nothing is.
+pub fn clip_segment_convex(a: DVec2, b: DVec2, poly: &[DVec2]) -> Option<(f64, f64)> {
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    let d = b - a;
+    for i in 0..poly.len() {
+        let p = poly[i];
+        let e = poly[(i + 1) % poly.len()] - p;
+        if e == DVec2::ZERO {
+            continue;
+        }
+        // Inside is to the left of e; f0 how far a is inside, fd its rate along a–b.
+        let f0 = e.perp_dot(a - p);
+        let fd = e.perp_dot(d);
+        if fd == 0.0 {
+            if f0 < 0.0 {
+                return None;
+            }
+            continue;
+        }
+        let t = -f0 / fd;
+        if fd > 0.0 {
+            t0 = t0.max(t);
+        } else {
+            t1 = t1.min(t);
+        }
+        if t0 >= t1 {
+            return None;
+        }
+    }
+    Some((t0, t1))
+}
+
 #[cfg(test)]
 mod test {
     use super::*;
