@@ -17,7 +17,7 @@ use spade::{
 
 use crate::arrangement::ArrFace;
 use crate::edges::ReceiverShadows;
-use crate::geom::polygon::orient;
+use crate::geom::polygon::{orient, segment_distance as seg_dist};
 use crate::regions::{Indexed, ReceiverRegions, RegionFace};
 use crate::relation::Relation;
 use crate::settings::Settings;
@@ -306,15 +306,6 @@ fn winding(verts: &[DVec2], l: &[u32], p: DVec2) -> i32 {
     w
 }
 
-fn seg_dist(a: DVec2, b: DVec2, p: DVec2) -> f64 {
-    let d = b - a;
-    let t = if d.length_squared() > 0.0 {
-        ((p - a).dot(d) / d.length_squared()).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (a + d * t - p).length()
-}
 
 /// Triangles, their regions (connected components across non-constraint edges, classified
 /// once each), and the D0 vertex split.

@@ -39,18 +39,10 @@ fn contact_shadow_splits_vertex_rows() {
     let b = check(&s);
     let fl = &b.meshes[0];
     // Vertices on the box's foot come in pairs (one per side) where light meets shadow.
-    let mut pos: Vec<[i64; 3]> = fl
-        .positions
-        .iter()
-        .map(|p| p.map(|x| (x * 1e9).round() as i64))
-        .collect();
-    let n = pos.len();
-    pos.sort();
-    pos.dedup();
+    let dup = duplicated(fl);
     assert!(
-        n - pos.len() >= 4,
-        "expected duplicated vertices along the contact line, got {}",
-        n - pos.len()
+        dup >= 4,
+        "expected duplicated vertices along the contact line, got {dup}"
     );
 }
 

@@ -334,18 +334,6 @@ fn check_all(s: &SceneJson) -> (Bake, f64, usize) {
     (b, max, n)
 }
 
-/// Positions that occur more than once in a mesh: D0 rows.
-fn duplicated(bm: &penumbra::BakedMesh) -> usize {
-    let mut pos: Vec<[i64; 3]> = bm
-        .positions
-        .iter()
-        .map(|p| p.map(|x| (x * 1e9).round() as i64))
-        .collect();
-    let n = pos.len();
-    pos.sort();
-    pos.dedup();
-    n - pos.len()
-}
 
 #[test]
 fn box_sunk_halfway_into_the_floor_area_light() {

@@ -31,16 +31,7 @@ fn scene_size(s: &SceneJson) -> f64 {
     (hi - lo).length()
 }
 
-/// Distance from `p` to segment ab.
-fn seg_dist(a: DVec2, b: DVec2, p: DVec2) -> f64 {
-    let d = b - a;
-    let t = if d.length_squared() > 0.0 {
-        ((p - a).dot(d) / d.length_squared()).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (a + d * t - p).length()
-}
+use penumbra::geom::polygon::segment_distance as seg_dist;
 
 /// Inside the closed polygon `poly` (any winding) or within `tol` of its boundary.
 fn inside(poly: &[DVec2], p: DVec2, tol: f64) -> bool {

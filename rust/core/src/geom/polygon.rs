@@ -184,6 +184,17 @@ pub fn clip_segment_convex(a: DVec2, b: DVec2, poly: &[DVec2]) -> Option<(f64, f
     Some((t0, t1))
 }
 
+/// Distance from `p` to the segment a–b.
+pub fn segment_distance(a: DVec2, b: DVec2, p: DVec2) -> f64 {
+    let d = b - a;
+    let t = if d.length_squared() > 0.0 {
+        ((p - a).dot(d) / d.length_squared()).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (a + d * t - p).length()
+}
+
 #[cfg(test)]
 mod test {
     use super::*;

@@ -342,3 +342,16 @@ pub fn uv_sphere(c: [f64; 3], r: f64, seg: usize, rings: usize) -> Vec<Vec<[f64;
     }
     out
 }
+
+/// Positions that occur more than once in a mesh (to 1e-9): D0 rows.
+pub fn duplicated(bm: &penumbra::BakedMesh) -> usize {
+    let mut pos: Vec<[i64; 3]> = bm
+        .positions
+        .iter()
+        .map(|p| p.map(|x| (x * 1e9).round() as i64))
+        .collect();
+    let n = pos.len();
+    pos.sort();
+    pos.dedup();
+    n - pos.len()
+}
