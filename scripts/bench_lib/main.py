@@ -87,12 +87,18 @@ def cycles(py, args, what):
     return rec
 
 
-def matched_uniform(exe, scene, work, tag, target, area, extra):
-    """A uniform mesh with about `target` elements: one trial, one correction."""
+def matched_uniform(exe, scene, work, tag, target, area, extra, timeout):
+    """A uniform mesh with about `target` elements: one trial, one correction. (None, None)
+    when a bake runs past `timeout` seconds: a uniform mesh makes every occluder a candidate
+    at every vertex, which in a cluttered room is far slower than the discontinuity mesh."""
     h = float(np.sqrt(area / (0.433 * target)))
     for it in range(2):
         rec, bake = penumbra_job.run_cli(exe, scene, work, f"{tag}-u{it}",
-                                         {**extra, "meshing": "uniform", "element_size": h})
+                                         {**extra, "meshing": "uniform", "element_size": h},
+                                         timeout=timeout)
+        if bake is None:
+            log(f"  uniform mesh stopped after {timeout:.0f} s: row left out")
+            return None, None
         n = rec["stats"]["N_e"]
         h *= float(np.sqrt(n / target))
     return rec, bake
@@ -158,12 +164,15 @@ def bench_scene(name, exe, py, work, cfg, out):
                          stats=rec["stats"], settings=rec["settings"],
                          **errors.errors(x, *refs["full"])))
     log("  uniform mesh, same element count")
-    rec, bake = matched_uniform(exe, scene, work, f"{name}-full", prow[0]["elements"], area, {})
-    x = penumbra_job.colors_at(bake, pm, pp, px)
-    prow.append(dict(method="Uniform mesh, same N_e", kind="uniform", wall=rec["wall"],
-                     peak_mb=rec["peak_mb"], elements=rec["stats"]["N_e"],
-                     stats=rec["stats"], settings=rec["settings"],
-                     **errors.errors(x, *refs["full"])))
+    limit = max(120.0, 20.0 * prow[0]["wall"])
+    rec, bake = matched_uniform(exe, scene, work, f"{name}-full", prow[0]["elements"], area, {},
+                                limit)
+    if bake is not None:
+        x = penumbra_job.colors_at(bake, pm, pp, px)
+        prow.append(dict(method="Uniform mesh, same N_e", kind="uniform", wall=rec["wall"],
+                         peak_mb=rec["peak_mb"], elements=rec["stats"]["N_e"],
+                         stats=rec["stats"], settings=rec["settings"],
+                         **errors.errors(x, *refs["full"])))
     for r in prow:
         t, how = errors.cycles_time_at(r["rel_rms"], curve) if r["rel_rms"] > 0 else (
             float("nan"), "error below reference noise")
@@ -194,7 +203,10 @@ def bench_scene(name, exe, py, work, cfg, out):
                               stats=rec["stats"], **er))
             if vis == "exact":
                 rec, bake = matched_uniform(exe, scene, work, f"{name}-d-{label}",
-                                            rec["stats"]["N_e"], area, nodirect)
+                                            rec["stats"]["N_e"], area, nodirect,
+                                            max(120.0, 20.0 * rec["wall"]))
+                if bake is None:
+                    continue
                 x = penumbra_job.colors_at(bake, pm, pp, px)
                 drows.append(dict(method=f"uniform, same N_e as {label}", kind="uniform",
                                   level=label, visibility="exact", wall=rec["wall"],
