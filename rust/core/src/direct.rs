@@ -28,9 +28,9 @@ use i_overlay::core::overlay_rule::OverlayRule;
 use i_overlay::float::overlay::FloatOverlay;
 use robust::{orient3d, Coord3D};
 
+use crate::geom::box_grid::bounds;
 use crate::geom::lambert::{contours_irradiance, polygon_irradiance};
 use crate::geom::plane::newell_normal;
-use crate::geom::box_grid::bounds;
 use crate::geom::polygon::{clip_polygon_3d, inside_convex, signed_area_2d};
 use crate::geom::{Frame, Plane};
 use crate::relation::Relation;

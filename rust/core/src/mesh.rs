@@ -306,7 +306,6 @@ fn winding(verts: &[DVec2], l: &[u32], p: DVec2) -> i32 {
     w
 }
 
-
 /// Triangles, their regions (connected components across non-constraint edges, classified
 /// once each), and the D0 vertex split.
 fn extract(

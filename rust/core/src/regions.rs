@@ -142,12 +142,7 @@ pub fn build_regions(
         );
     }
     let t0 = std::time::Instant::now();
-    let extent = r
-        .poly2
-        .iter()
-        .map(|p| (*p - r.poly2[0]).length())
-        .fold(0.0, f64::max)
-        .max(diag * 1e-9);
+    let extent = receiver_extent(r, diag);
     let snap = 1e-9 * extent;
     // Parts of edges deep inside an umbra of their own light would only be dropped again
     // after the arrangement; a few snap distances keep rounding off the umbra boundaries.
@@ -276,16 +271,21 @@ pub fn build_regions(
     )
 }
 
+/// The receiver's size (its farthest vertex from the first), never below 1e-9 of the scene:
+/// the arrangement's snapping distance is relative to it.
+fn receiver_extent(r: &Face, diag: f64) -> f64 {
+    r.poly2
+        .iter()
+        .map(|p| (*p - r.poly2[0]).length())
+        .fold(0.0, f64::max)
+        .max(diag * 1e-9)
+}
+
 /// The whole receiver as one region, for uniform meshing: every light that reaches it is
 /// treated as penumbra with every occluder that shadows any part of it as candidate, so the
 /// light at each vertex is still exact.
 fn uniform_regions(r: &Face, sh: &ReceiverShadows, diag: f64) -> ReceiverRegions {
-    let extent = r
-        .poly2
-        .iter()
-        .map(|p| (*p - r.poly2[0]).length())
-        .fold(0.0, f64::max)
-        .max(diag * 1e-9);
+    let extent = receiver_extent(r, diag);
     let arr = arrangement::build(&r.poly2, &[], 1e-9 * extent);
     let n = sh.exposure.len();
     let mut rf = RegionFace {

@@ -212,7 +212,10 @@ mod test {
 
     #[test]
     fn cuts_segments_deep_inside_and_keeps_edges_along_boundaries() {
-        let polys = vec![sq(0.0, 0.0, 1.0, 1.0, true, 0), sq(2.0, 0.0, 3.0, 1.0, true, 1)];
+        let polys = vec![
+            sq(0.0, 0.0, 1.0, 1.0, true, 0),
+            sq(2.0, 0.0, 3.0, 1.0, true, 1),
+        ];
         let cover = UmbraCover::new(&polys, 1e-9);
         let (mut s, mut out) = (Vec::new(), Vec::new());
         // Through both squares: the three pieces outside them, ending on their boundaries.
@@ -231,7 +234,14 @@ mod test {
         }
         // Wholly inside: nothing left.
         out.clear();
-        cover.uncovered(DVec2::new(0.2, 0.2), DVec2::new(0.8, 0.3), 0, None, &mut s, &mut out);
+        cover.uncovered(
+            DVec2::new(0.2, 0.2),
+            DVec2::new(0.8, 0.3),
+            0,
+            None,
+            &mut s,
+            &mut out,
+        );
         assert!(out.is_empty());
     }
 }

@@ -334,7 +334,6 @@ fn check_all(s: &SceneJson) -> (Bake, f64, usize) {
     (b, max, n)
 }
 
-
 #[test]
 fn box_sunk_halfway_into_the_floor_area_light() {
     let s = scene(

@@ -103,7 +103,10 @@ fn floor_light_matches_all_faces_as_blockers() {
         worst = worst.max((c[0] - want).abs() / top);
     }
     assert!(shaded > 100, "only {shaded} shaded floor vertices");
-    assert!(worst < 1e-9, "floor light off by {worst:e} of the brightest vertex");
+    assert!(
+        worst < 1e-9,
+        "floor light off by {worst:e} of the brightest vertex"
+    );
 }
 
 #[test]
