@@ -54,6 +54,8 @@ pub struct Stats {
     /// fraction of the emitted power.
     pub shots: u64,
     pub unshot_fraction: f64,
+    /// Element vertices at which indirect light was computed (the rest interpolate).
+    pub N_gather: u64,
     /// Vertex×light pairs: skipped in umbra, computed unoccluded in lit regions, computed
     /// with visibility in penumbra.
     pub pairs_umbra: u64,
@@ -191,6 +193,7 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
         stats.N_p = ind.patches;
         stats.shots = ind.shots;
         stats.unshot_fraction = ind.unshot_fraction;
+        stats.N_gather = ind.gather_vertices;
         for (e, i) in irradiance.iter_mut().zip(&ind.irradiance) {
             *e += *i;
         }
@@ -336,7 +339,7 @@ fn output(scene: &Scene, el: &Elements, colors: &[[f64; 3]]) -> Vec<BakedMesh> {
 /// The stats as a text table in the layout of the paper's Tables 2 and 4.
 pub fn stats_table(s: &Stats) -> String {
     let mut t = String::new();
-    let rows: [(&str, String); 22] = [
+    let rows: [(&str, String); 23] = [
         ("receivers before loop split  N_f1", s.N_f1.to_string()),
         ("faces after loop split       N_f2", s.N_f2.to_string()),
         ("discontinuity edges          N_d", s.N_d.to_string()),
@@ -384,6 +387,7 @@ pub fn stats_table(s: &Stats) -> String {
             format!("{:.4}", s.T_direct),
         ),
         ("radiosity              T_rs (s)", format!("{:.4}", s.T_rs)),
+        ("indirect at vertices   N_gather", s.N_gather.to_string()),
         ("total                  (s)", format!("{:.4}", s.T_total)),
         (
             "shots / unshot fraction",

@@ -23,6 +23,25 @@ pub struct Open {
 /// which two planes count as the same.
 pub fn open_parts(faces: &[Face], tol: f64) -> Vec<Vec<Open>> {
     let tol = tol.max(f64::MIN_POSITIVE);
+    faces
+        .iter()
+        .zip(covers(faces, tol))
+        .map(|(f, covers)| {
+            let whole = vec![Open {
+                poly: f.poly2.clone(),
+                cuts: Vec::new(),
+            }];
+            covers
+                .iter()
+                .fold(whole, |parts, c| subtract(parts, c, tol))
+        })
+        .collect()
+}
+
+/// Per face, the coplanar opposite faces that overlap its plane, as polygons in the face's
+/// frame, counter-clockwise. `tol` as for `open_parts`.
+pub fn covers(faces: &[Face], tol: f64) -> Vec<Vec<Vec<DVec2>>> {
+    let tol = tol.max(f64::MIN_POSITIVE);
     // Faces by their plane offset, in buckets of `tol`: a coplanar opposite face has the
     // negated offset, within a bucket of it.
     let key = |d: f64| (d / tol).floor() as i64;
@@ -33,12 +52,8 @@ pub fn open_parts(faces: &[Face], tol: f64) -> Vec<Vec<Open>> {
     faces
         .iter()
         .map(|f| {
-            let whole = vec![Open {
-                poly: f.poly2.clone(),
-                cuts: Vec::new(),
-            }];
             let k = key(-f.plane.d);
-            let covers: Vec<Vec<DVec2>> = (k - 1..=k + 1)
+            (k - 1..=k + 1)
                 .filter_map(|b| by_offset.get(&b))
                 .flatten()
                 .map(|&g| &faces[g as usize])
@@ -53,10 +68,7 @@ pub fn open_parts(faces: &[Face], tol: f64) -> Vec<Vec<Open>> {
                     c
                 })
                 .filter(|c| signed_area_2d(c) > 0.0)
-                .collect();
-            covers
-                .iter()
-                .fold(whole, |parts, c| subtract(parts, c, tol))
+                .collect()
         })
         .collect()
 }

@@ -33,3 +33,29 @@ pub struct Region {
     pub relations: Vec<Relation>,
     pub blockers: Vec<Vec<u32>>,
 }
+
+impl Elements {
+    /// The triangle corners at each vertex, as (triangle, corner) in triangle order:
+    /// `around[start[v]..start[v + 1]]`.
+    pub fn corners_by_vertex(&self) -> (Vec<u32>, Vec<(u32, u8)>) {
+        let nv = self.positions.len();
+        let mut start = vec![0u32; nv + 1];
+        for t in &self.triangles {
+            for &v in t {
+                start[v as usize + 1] += 1;
+            }
+        }
+        for v in 0..nv {
+            start[v + 1] += start[v];
+        }
+        let mut fill = start.clone();
+        let mut around = vec![(0u32, 0u8); start[nv] as usize];
+        for (t, tri) in self.triangles.iter().enumerate() {
+            for (i, &v) in tri.iter().enumerate() {
+                around[fill[v as usize] as usize] = (t as u32, i as u8);
+                fill[v as usize] += 1;
+            }
+        }
+        (start, around)
+    }
+}

@@ -16,11 +16,18 @@
 //! (`fit`). Shots are parallel over receiver vertices; each vertex's value is computed
 //! alone and added in a fixed order, so results do not depend on the thread count.
 //!
+//! Light is computed at a subset of the element vertices and interpolated at the others
+//! (`gather`, by moving least squares: `mls`): the elements are as fine as direct light
+//! needs, and indirect light is smooth across a penumbra.
+//!
 //! Files: `shooter` (a shot and its kept factors), `blockers` (what could be in the way),
-//! `receiver` (one vertex's factor), `fit` (far groups).
+//! `receiver` (one vertex's factor), `fit` (far groups), `gather` and `mls` (which
+//! vertices, and the rest from them).
 
 mod blockers;
 mod fit;
+mod gather;
+mod mls;
 mod receiver;
 mod shooter;
 
@@ -28,6 +35,7 @@ use std::f64::consts::PI;
 
 use glam::DVec3;
 
+use gather::Gather;
 #[cfg(test)]
 use receiver::form_factor;
 use shooter::Shooter;
@@ -45,6 +53,8 @@ pub struct IndirectResult {
     /// at least one diffuse bounce, plus what emissive faces send.
     pub irradiance: Vec<DVec3>,
     pub patches: u64,
+    /// Element vertices at which indirect light was computed; the rest interpolate.
+    pub gather_vertices: u64,
     pub shots: u64,
     /// Unshot power left at the end over the power emitted (reflected direct light plus
     /// emission), before any ambient term.
@@ -67,6 +77,9 @@ const FACE_OCCLUDER_BUDGET: usize = 1 << 24;
 /// most): a vertex's factor is one, a run of vertices two, a receiving patch's gain four.
 /// A closed room of 24k vertices and 2.6k patches keeps about 41M.
 const FACTOR_BUDGET: usize = 1 << 26;
+/// Indirect light is computed at vertices about this many element sizes apart and
+/// interpolated between (`gather`).
+const GATHER_SPACING: f64 = 1.0;
 /// Receiver vertices per parallel work item.
 const CHUNK: usize = 256;
 
@@ -114,7 +127,18 @@ pub fn indirect(
         return Ok(result);
     }
 
-    let shooter = Shooter::new(scene, el, &patches, occ, emitted);
+    // D0-row copies sit at least 1e-9 of the scene off their line (`mesh`), so a tenth of
+    // that tells their side from the line itself.
+    let covers = crate::covered::covers(&scene.faces, 1e-6 * scene.diagonal());
+    let gather = Gather::new(
+        &scene.faces,
+        &covers,
+        el,
+        GATHER_SPACING * settings.element_size,
+        1e-10 * scene.diagonal(),
+    );
+    result.gather_vertices = gather.kept_count() as u64;
+    let shooter = Shooter::new(scene, el, &patches, occ, emitted, &gather);
     // Radiosity shot so far by each patch whose factors are kept.
     let mut shot_total = vec![DVec3::ZERO; patches.len()];
     let mut remaining;
@@ -150,6 +174,7 @@ pub fn indirect(
         result.shots += 1;
     }
     shooter.add_kept(&shot_total, &mut irradiance);
+    gather.spread(&mut irradiance);
     result.unshot_fraction = remaining / emitted;
 
     if settings.ambient {

@@ -24,23 +24,11 @@ pub fn direct_irradiance(
 ) -> Result<(Vec<DVec3>, [u64; 3]), crate::BakeError> {
     let nv = el.positions.len();
     // Regions around each vertex (CSR).
-    let mut count = vec![0u32; nv + 1];
-    for t in &el.triangles {
-        for &v in t {
-            count[v as usize + 1] += 1;
-        }
-    }
-    for i in 0..nv {
-        count[i + 1] += count[i];
-    }
-    let mut fill = count.clone();
-    let mut around = vec![0u32; count[nv] as usize];
-    for (ti, t) in el.triangles.iter().enumerate() {
-        for &v in t {
-            around[fill[v as usize] as usize] = el.tri_region[ti];
-            fill[v as usize] += 1;
-        }
-    }
+    let (count, corners) = el.corners_by_vertex();
+    let around: Vec<u32> = corners
+        .iter()
+        .map(|&(t, _)| el.tri_region[t as usize])
+        .collect();
     let done = std::sync::atomic::AtomicUsize::new(0);
     let results: Vec<(DVec3, [u64; 3])> = (0..nv)
         .into_par_iter()

@@ -168,6 +168,22 @@ impl Occluders {
         faces.iter().any(|&f| self.face_crosses_segment(f, a, b))
     }
 
+    /// Signed distance of `p` from face `id`'s plane.
+    pub fn plane_dist(&self, id: u32, p: DVec3) -> f64 {
+        self.faces[id as usize].plane.dist(p)
+    }
+
+    /// True if one of `faces` crosses the segment from `a` to `b`, each face given with
+    /// `a`'s distance from its plane (`plane_dist`), which many segments from `a` share.
+    pub fn segment_blocked_from(&self, a: DVec3, b: DVec3, faces: &[(u32, f64)]) -> bool {
+        faces.iter().any(|&(id, da)| {
+            let f = &self.faces[id as usize];
+            let db = f.plane.dist(b);
+            let crosses = (da > self.tol && db < -self.tol) || (da < -self.tol && db > self.tol);
+            crosses && !f.edges.is_empty() && f.contains(a + (b - a) * (da / (da - db)), self.tol)
+        })
+    }
+
     /// True if a face crosses the ray from `origin` (excluded) along `dir` to infinity.
     pub fn ray_blocked(&self, origin: DVec3, dir: DVec3) -> bool {
         self.ray_blocked_skip(origin, dir, &[])

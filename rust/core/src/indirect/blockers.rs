@@ -37,7 +37,9 @@ pub(super) struct Pair<'s> {
 
 pub(super) enum Blockers {
     None,
-    Listed(Vec<u32>),
+    /// Faces that could block, each with the range of the patch's distances from its
+    /// plane: a vertex on the same side as all of the patch needs no ray tested against it.
+    Listed(Vec<(u32, f64, f64)>),
     Any,
 }
 
@@ -146,8 +148,16 @@ impl Shooter<'_> {
         })
     }
 
-    /// What could stand between the shooter and the vertices of `group`.
-    pub(super) fn blockers(&self, fp: u32, plane: &Plane, pair: &Pair, group: &Group) -> Blockers {
+    /// What could stand between the shooter (`patch`, its whole polygon) and the vertices
+    /// of `group`.
+    pub(super) fn blockers(
+        &self,
+        fp: u32,
+        patch: &[DVec3],
+        plane: &Plane,
+        pair: &Pair,
+        group: &Group,
+    ) -> Blockers {
         let Some(known) = pair.known else {
             return Blockers::None;
         };
@@ -170,7 +180,15 @@ impl Shooter<'_> {
         list.retain(|&o| self.occ.straddled_by(o, &pair.poly, group.lo, group.hi));
         match list.len() {
             0 => Blockers::None,
-            n if n <= MAX_LISTED_OCCLUDERS => Blockers::Listed(list),
+            n if n <= MAX_LISTED_OCCLUDERS => Blockers::Listed(
+                list.into_iter()
+                    .map(|o| {
+                        let d = patch.iter().map(|v| self.occ.plane_dist(o, *v));
+                        let lo = d.clone().fold(f64::INFINITY, f64::min);
+                        (o, lo, d.fold(f64::NEG_INFINITY, f64::max))
+                    })
+                    .collect(),
+            ),
             _ => Blockers::Any,
         }
     }

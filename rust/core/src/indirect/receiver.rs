@@ -7,7 +7,7 @@ use glam::DVec3;
 
 use super::blockers::{Blockers, Pair};
 use super::shooter::Shooter;
-use super::{FEW_RAYS_BELOW, ONE_RAY_BELOW};
+use super::{FEW_RAYS_BELOW, MAX_LISTED_OCCLUDERS, ONE_RAY_BELOW};
 use crate::geom::Plane;
 use crate::patches::Patch;
 
@@ -33,8 +33,25 @@ impl Shooter<'_> {
             return 0.0;
         }
         let e = b * ff;
+        // Of a listed blocker's plane, the vertex must lie on the other side from part of
+        // the patch for any ray to cross it; the others are left out for this vertex, and
+        // with none left the patch is in full view.
+        let mut near = [(0u32, 0.0f64); MAX_LISTED_OCCLUDERS];
+        let mut n_near = 0;
+        if let Blockers::Listed(list) = blockers {
+            let tol = self.occ.tolerance();
+            for &(o, lo, hi) in list {
+                let da = self.occ.plane_dist(o, x);
+                if (da > tol && lo < -tol) || (da < -tol && hi > tol) {
+                    near[n_near] = (o, da);
+                    n_near += 1;
+                }
+            }
+        }
+        let near = &near[..n_near];
         let vis = match blockers {
             Blockers::None => 1.0,
+            Blockers::Listed(_) if near.is_empty() => 1.0,
             blockers => {
                 let size = patch.radius / (patch.centroid - x).length();
                 let level = if e.max_element() < self.negligible || size < ONE_RAY_BELOW {
@@ -46,7 +63,7 @@ impl Shooter<'_> {
                 };
                 let skip = [patch.face, pair.face];
                 let blocked = |s: DVec3| match blockers {
-                    Blockers::Listed(list) => self.occ.segment_blocked_by(x, s, list),
+                    Blockers::Listed(_) => self.occ.segment_blocked_from(x, s, near),
                     _ => self.occ.segment_blocked_skip(x, s, &skip),
                 };
                 // Each ray counts by its own point-to-point form factor, cosθ·cosθ'/r², not

@@ -9,6 +9,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::blockers::{Blockers, Pair, Reached};
+use super::gather::Gather;
 use super::{mean, CHUNK, FACTOR_BUDGET};
 use crate::elements::Elements;
 use crate::geom::raycast::Occluders;
@@ -52,6 +53,8 @@ pub(super) struct Shooter<'a> {
     /// vertex, and how many vertices were.
     pub(super) fit: bool,
     pub(super) fitted_verts: AtomicUsize,
+    /// Each patch's weighted mean (`Patch::weights`) over kept vertices only (`gather`).
+    pub(super) patch_weights: Vec<Vec<(u32, f64)>>,
 }
 
 /// A patch's shot, kept for the next: form factor times visibility for the vertices
@@ -80,6 +83,7 @@ impl<'a> Shooter<'a> {
         patches: &'a [Patch],
         occ: &'a Occluders,
         emitted: f64,
+        gather: &Gather,
     ) -> Self {
         let nf = scene.faces.len();
         let mut vert_start = vec![0u32; nf + 1];
@@ -96,17 +100,23 @@ impl<'a> Shooter<'a> {
         for f in 0..nf {
             patch_start[f + 1] += patch_start[f];
         }
-        // Each vertex joins the group of the first patch it weighs in; vertices in no patch
-        // (in no triangle) form one last group of their face.
+        let patch_weights: Vec<Vec<(u32, f64)>> = patches
+            .par_iter()
+            .map(|p| gather.compose(&p.weights))
+            .collect();
+        // Each kept vertex joins the group of the first patch it weighs in; vertices in no
+        // patch (in no triangle) form one last group of their face.
         let mut group_of = vec![u32::MAX; el.positions.len()];
-        for (i, p) in patches.iter().enumerate() {
-            for &(v, _) in &p.weights {
+        for (i, w) in patch_weights.iter().enumerate() {
+            for &(v, _) in w {
                 if group_of[v as usize] == u32::MAX {
                     group_of[v as usize] = i as u32;
                 }
             }
         }
-        let mut order: Vec<u32> = (0..el.positions.len() as u32).collect();
+        let mut order: Vec<u32> = (0..el.positions.len() as u32)
+            .filter(|&v| gather.kept[v as usize])
+            .collect();
         order.sort_by_key(|&v| (el.vertex_face[v as usize], group_of[v as usize], v));
         let mut face_verts = Vec::with_capacity(order.len());
         let mut groups: Vec<Group> = Vec::new();
@@ -193,6 +203,7 @@ impl<'a> Shooter<'a> {
             factors_kept: AtomicUsize::new(0),
             fit: true,
             fitted_verts: AtomicUsize::new(0),
+            patch_weights,
         }
     }
 
@@ -241,7 +252,7 @@ impl<'a> Shooter<'a> {
                 let pair = &pairs[k];
                 let mut out = Vec::new();
                 for group in &self.groups[g0..g1] {
-                    let blockers = self.blockers(patch.face, &plane, pair, group);
+                    let blockers = self.blockers(patch.face, &patch.poly, &plane, pair, group);
                     if self.fit && matches!(blockers, Blockers::None) {
                         if let Some(vals) = self.fitted(patch, &plane, pair, group) {
                             out.extend(vals);
@@ -277,7 +288,7 @@ impl<'a> Shooter<'a> {
         let to_patches: Vec<(u32, f64)> = touched
             .par_iter()
             .with_min_len(64)
-            .map(|&q| (q as u32, mean(&self.patches[q].weights, &g_of)))
+            .map(|&q| (q as u32, mean(&self.patch_weights[q], &g_of)))
             .collect::<Vec<_>>()
             .into_iter()
             .filter(|&(_, m)| m != 0.0)
