@@ -34,6 +34,7 @@ mod shooter;
 use std::f64::consts::PI;
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use gather::Gather;
 #[cfg(test)]
@@ -93,6 +94,19 @@ pub fn indirect(
     occ: &Occluders,
     progress: &Progress,
 ) -> Result<IndirectResult, BakeError> {
+    let spacing = GATHER_SPACING * scene.settings.element_size;
+    indirect_at(scene, el, direct, occ, progress, spacing)
+}
+
+/// `indirect`, computed at vertices about `spacing` apart (every vertex for 0).
+fn indirect_at(
+    scene: &Scene,
+    el: &Elements,
+    direct: &[DVec3],
+    occ: &Occluders,
+    progress: &Progress,
+    spacing: f64,
+) -> Result<IndirectResult, BakeError> {
     let settings = &scene.settings;
     let nv = el.positions.len();
     if direct.len() != nv {
@@ -130,17 +144,13 @@ pub fn indirect(
     // D0-row copies sit at least 1e-9 of the scene off their line (`mesh`), so a tenth of
     // that tells their side from the line itself.
     let covers = crate::covered::covers(&scene.faces, 1e-6 * scene.diagonal());
-    let gather = Gather::new(
-        &scene.faces,
-        &covers,
-        el,
-        GATHER_SPACING * settings.element_size,
-        1e-10 * scene.diagonal(),
-    );
+    let gather = Gather::new(&scene.faces, &covers, el, spacing, 1e-10 * scene.diagonal());
     result.gather_vertices = gather.kept_count() as u64;
     let shooter = Shooter::new(scene, el, &patches, occ, emitted, &gather);
     // Radiosity shot so far by each patch whose factors are kept.
     let mut shot_total = vec![DVec3::ZERO; patches.len()];
+    // Radiosity shot so far by each patch, for vertices computed at the end.
+    let mut shot_all = vec![DVec3::ZERO; patches.len()];
     let mut remaining;
     loop {
         progress.check()?;
@@ -162,6 +172,7 @@ pub fn indirect(
         }
 
         let b = std::mem::take(&mut unshot[best]);
+        shot_all[best] += b;
         // A kept patch's repeat shots are added once, at the end (`add_kept`).
         let (factors, exact) = shooter.factors(best, b);
         match exact {
@@ -174,7 +185,15 @@ pub fn indirect(
         result.shots += 1;
     }
     shooter.add_kept(&shot_total, &mut irradiance);
-    gather.spread(&mut irradiance);
+    let unsure = gather.spread(&mut irradiance);
+    let exact: Vec<DVec3> = unsure
+        .par_iter()
+        .map(|&v| shooter.gathered(v, &shot_all))
+        .collect();
+    for (&v, e) in unsure.iter().zip(exact) {
+        irradiance[v as usize] = e;
+    }
+    result.gather_vertices += unsure.len() as u64;
     result.unshot_fraction = remaining / emitted;
 
     if settings.ambient {

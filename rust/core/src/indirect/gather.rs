@@ -30,6 +30,9 @@ use crate::scene::Face;
 /// Boundary vertices where the border turns by more than this (radians) are always kept:
 /// corners of faces and ends of D0 rows, where a fit would have to extrapolate.
 const CORNER_TURN: f64 = 0.35;
+/// Interpolated values whose two interpolants differ by more than this fraction of the
+/// largest value they use are computed instead (`Gather::spread`).
+const UNSURE: f64 = 0.01;
 /// Near a contact the spacing is at most this times the distance to it (`spacings`).
 const GRADE: f64 = 0.5;
 
@@ -40,6 +43,10 @@ pub(super) struct Gather {
     /// `weights[start[v]..start[v + 1]]`; empty for kept vertices.
     start: Vec<u32>,
     weights: Vec<(u32, f64)>,
+    /// A second, lower-order interpolant of the same vertex (empty where the first is
+    /// already low-order): `check[check_start[v]..check_start[v + 1]]`.
+    check_start: Vec<u32>,
+    check: Vec<(u32, f64)>,
 }
 
 impl Gather {
@@ -49,6 +56,8 @@ impl Gather {
             kept: vec![true; nv],
             start: vec![0; nv + 1],
             weights: Vec::new(),
+            check_start: vec![0; nv + 1],
+            check: Vec::new(),
         }
     }
 
@@ -82,7 +91,10 @@ impl Gather {
 
         let mut start = Vec::with_capacity(nv + 1);
         let mut weights = Vec::new();
+        let mut check_start = Vec::with_capacity(nv + 1);
+        let mut check = Vec::new();
         start.push(0);
+        check_start.push(0);
         let mut cands = Vec::new();
         for v in 0..nv {
             if !kept[v] {
@@ -99,27 +111,27 @@ impl Gather {
                 }
                 cands.sort_unstable();
                 cands.dedup();
-                if !fit::<6>(uv[v], &cands, &uv, &mut weights) {
-                    cands.clear();
-                    cands.push(c);
-                    cands.extend_from_slice(near.of(c));
-                    if !fit::<3>(uv[v], &cands, &uv, &mut weights) {
-                        shepard(uv[v], &cands, &uv, &mut weights);
-                    }
+                let quadratic = fit::<6>(uv[v], &cands, &uv, &mut weights);
+                cands.clear();
+                cands.push(c);
+                cands.extend_from_slice(near.of(c));
+                // The check: a linear fit over the first ring, or inverse distance. Where
+                // it and the quadratic disagree, light is not smooth there.
+                let out = if quadratic { &mut check } else { &mut weights };
+                if !fit::<3>(uv[v], &cands, &uv, out) {
+                    shepard(uv[v], &cands, &uv, out);
                 }
             }
             start.push(weights.len() as u32);
+            check_start.push(check.len() as u32);
         }
         Gather {
             kept,
             start,
             weights,
+            check_start,
+            check,
         }
-    }
-
-    #[cfg(test)]
-    pub(super) fn weights_at(&self, v: usize) -> &[(u32, f64)] {
-        &self.weights[self.start[v] as usize..self.start[v + 1] as usize]
     }
 
     pub(super) fn kept_count(&self) -> usize {
@@ -153,19 +165,34 @@ impl Gather {
         merged
     }
 
-    /// Fills the vertices not kept from the kept ones. A linear fit can overshoot where
-    /// light changes fast; irradiance is never negative.
-    pub(super) fn spread(&self, values: &mut [DVec3]) {
+    /// Fills the vertices not kept from the kept ones, and returns those where the
+    /// interpolants disagree by more than `UNSURE` of the largest value they draw on: light
+    /// changes there faster than the kept vertices can show (an emitter's shadow, the
+    /// shadow of a bright wall's light beside a box), and the caller computes them.
+    /// A linear fit can overshoot; irradiance is never negative.
+    pub(super) fn spread(&self, values: &mut [DVec3]) -> Vec<u32> {
+        let at = |w: &[(u32, f64)], values: &[DVec3]| -> (DVec3, f64) {
+            w.iter().fold((DVec3::ZERO, 0.0f64), |(s, m), &(k, b)| {
+                let x = values[k as usize];
+                (s + x * b, m.max(x.max_element()))
+            })
+        };
+        let mut unsure = Vec::new();
         for v in 0..values.len() {
             if !self.kept[v] {
-                let (s, e) = (self.start[v], self.start[v + 1]);
-                let x: DVec3 = self.weights[s as usize..e as usize]
-                    .iter()
-                    .map(|&(k, b)| values[k as usize] * b)
-                    .sum();
+                let w = &self.weights[self.start[v] as usize..self.start[v + 1] as usize];
+                let c = &self.check[self.check_start[v] as usize..self.check_start[v + 1] as usize];
+                let (x, top) = at(w, values);
+                if !c.is_empty() {
+                    let (y, _) = at(c, values);
+                    if (x - y).abs().max_element() > UNSURE * top {
+                        unsure.push(v as u32);
+                    }
+                }
                 values[v] = x.max(DVec3::ZERO);
             }
         }
+        unsure
     }
 }
 
@@ -301,7 +328,7 @@ fn choose(uv: &[DVec2], adj: &Adjacency, prio: &[u8], spacing: &[f64]) -> Vec<bo
 }
 
 /// Each vertex's spacing: `base`, but `GRADE` times its distance to the nearest contact (a
-/// D0 row, a cut or the border of the face) where closer, down to `base / 4`. Where two
+/// D0 row, a cut or the border of the face) where closer, down to `base / 16`. Where two
 /// faces meet, light from one onto the other changes on the scale of the smaller (a chair's
 /// leg), and where two contacts meet (the corner of a box's foot) it depends on the
 /// direction to the corner, not on the distance, as direct light does at D0 ends.
@@ -322,7 +349,7 @@ fn spacings(uv: &[DVec2], el: &Elements, class: &[u8], base: f64) -> Vec<f64> {
         .collect();
     let (dist, _) = nearest(uv, &all, &contact);
     dist.iter()
-        .map(|&d| (GRADE * d).clamp(base / 4.0, base))
+        .map(|&d| (GRADE * d).clamp(base / 16.0, base))
         .collect()
 }
 

@@ -6,12 +6,40 @@ use std::f64::consts::PI;
 use glam::DVec3;
 
 use super::blockers::{Blockers, Pair};
-use super::shooter::Shooter;
+use super::shooter::{Group, Shooter};
 use super::{FEW_RAYS_BELOW, MAX_LISTED_OCCLUDERS, ONE_RAY_BELOW};
 use crate::geom::Plane;
 use crate::patches::Patch;
 
 impl Shooter<'_> {
+    /// Everything the shots sent to vertex `v`, computed there alone (`shot_all`: the
+    /// radiosity each patch shot over the whole bake): for a vertex whose interpolated
+    /// value is unsure.
+    pub(super) fn gathered(&self, v: u32, shot_all: &[DVec3]) -> DVec3 {
+        let f = self.el.vertex_face[v as usize];
+        let x = self.points[v as usize];
+        let group = Group {
+            start: 0,
+            end: 0,
+            lo: x,
+            hi: x,
+        };
+        let mut sum = DVec3::ZERO;
+        for (patch, &b) in self.patches.iter().zip(shot_all) {
+            if b == DVec3::ZERO {
+                continue;
+            }
+            let plane = self.scene.faces[patch.face as usize].plane;
+            let known = self.face_blockers(patch.face);
+            let Some(pair) = self.pair(&patch.poly, patch.face, &plane, f, known) else {
+                continue;
+            };
+            let blockers = self.blockers(patch.face, &patch.poly, &plane, &pair, &group);
+            sum += b * self.receive(patch, &plane, &pair, &blockers, v, b);
+        }
+        sum
+    }
+
     /// Form factor from vertex `v` to the shooter times the fraction of it in view: the
     /// vertex gets `b` times this. (`b` only decides how hard to look.)
     pub(super) fn receive(
