@@ -180,6 +180,7 @@ pub fn shadow_polygons(
     let tree = BoxTree::new(faces.iter().map(|f| Aabb::from_points(&f.verts)).collect());
     let outlines: Vec<(Vec<DVec3>, Vec<[DVec3; 2]>)> =
         occs.iter().map(|o| occluder_outline(o, faces)).collect();
+    let buried = crate::buried::burial(scene, eps);
     let mut stats = EdgeStats::default();
     let mut per_receiver: Vec<ReceiverShadows> = (0..faces.len())
         .map(|i| ReceiverShadows {
@@ -200,7 +201,12 @@ pub fn shadow_polygons(
         let volumes: Vec<Vec<ShadowVolumes>> = occs
             .par_iter()
             .enumerate()
-            .map(|(oi, o)| occluder_volumes(&light.kind, None, oi as u32, o, faces, eps))
+            .map(|(oi, o)| {
+                if buried.occluders[oi] {
+                    return Vec::new();
+                }
+                occluder_volumes(&light.kind, None, oi as u32, o, faces, eps)
+            })
             .collect();
         stats.shadow_pairs += volumes.iter().filter(|v| !v.is_empty()).count() as u64;
         stats.culled_pairs += volumes.iter().filter(|v| v.is_empty()).count() as u64;
@@ -249,6 +255,9 @@ pub fn shadow_polygons(
             .par_iter()
             .enumerate()
             .map(|(ri, r)| {
+                if buried.faces[ri] {
+                    return OnReceiver::hidden();
+                }
                 receiver_polygons(
                     li as u32,
                     &light.kind,
@@ -288,9 +297,11 @@ pub fn shadow_polygons(
         stats.t_isr += t1.elapsed().as_secs_f64();
     }
     let t2 = std::time::Instant::now();
-    per_receiver
-        .par_iter_mut()
-        .for_each(|r| crate::umbra_cover::drop_covered(&mut r.polys));
+    per_receiver.par_iter_mut().zip(faces).for_each(|(r, f)| {
+        crate::umbra_cover::drop_covered(&mut r.polys, &r.inside);
+        let snap = 1e-9 * f.extent(scene.diagonal());
+        crate::umbra_cover::trim_lines(r, snap);
+    });
     stats.t_isr += t2.elapsed().as_secs_f64();
     Ok((per_receiver, stats))
 }
@@ -386,6 +397,18 @@ fn receiver_polygons(
         let recomputed;
         let svs: &[ShadowVolumes] = match &clipped_light {
             None => &volumes[oi as usize],
+            // The light cut down to the receiver's front is part of the light, so its
+            // penumbra lies inside the whole light's: where that misses the receiver there
+            // is nothing to recompute.
+            Some(_)
+                if volumes[oi as usize].iter().all(|sv| {
+                    sv.penumbra
+                        .iter()
+                        .all(|p| clip_to_volume(r, p, eps).is_none())
+                }) =>
+            {
+                continue;
+            }
             Some(lv) => {
                 recomputed = occluder_volumes(
                     kind,
