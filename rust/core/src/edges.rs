@@ -10,7 +10,7 @@ use crate::cuts::{inside_solid, plane_cut};
 use crate::events::critical_segments;
 use crate::geom::bvh::{Aabb, BoxTree};
 use crate::geom::polygon::{
-    clip_polygon_2d, clip_polygon_3d, signed_area_2d, simplify_convex, HalfPlane,
+    clip_polygon_2d, clip_polygon_3d, inside_convex, signed_area_2d, simplify_convex, HalfPlane,
 };
 use crate::geom::{Frame, Plane};
 use crate::scene::solids::Occluder;
@@ -394,21 +394,32 @@ fn receiver_polygons(
                 inside.push(p);
             }
         }
+    }
+    for &oi in hits {
+        if outlines[oi as usize]
+            .0
+            .iter()
+            .all(|v| r.plane.dist(*v) <= eps)
+        {
+            continue;
+        }
+        // A shadow that falls wholly inside solids on this receiver decides nothing
+        // (`umbra_cover::drop_covered` would drop it); nor do the critical lines in it. The
+        // shadow under the light cut down to the receiver's front lies inside it.
+        let whole = volumes[oi as usize]
+            .iter()
+            .flat_map(|sv| &sv.penumbra)
+            .filter_map(|p| clip_to_volume(r, p, eps));
+        if whole.into_iter().all(|p| {
+            inside
+                .iter()
+                .any(|q: &Vec<DVec2>| p.iter().all(|&v| inside_convex(q, v)))
+        }) {
+            continue;
+        }
         let recomputed;
         let svs: &[ShadowVolumes] = match &clipped_light {
             None => &volumes[oi as usize],
-            // The light cut down to the receiver's front is part of the light, so its
-            // penumbra lies inside the whole light's: where that misses the receiver there
-            // is nothing to recompute.
-            Some(_)
-                if volumes[oi as usize].iter().all(|sv| {
-                    sv.penumbra
-                        .iter()
-                        .all(|p| clip_to_volume(r, p, eps).is_none())
-                }) =>
-            {
-                continue;
-            }
             Some(lv) => {
                 recomputed = occluder_volumes(
                     kind,
