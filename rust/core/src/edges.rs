@@ -10,7 +10,7 @@ use crate::cuts::{inside_solid, plane_cut};
 use crate::events::critical_segments;
 use crate::geom::bvh::{Aabb, BoxTree};
 use crate::geom::polygon::{
-    clip_polygon_2d, clip_polygon_3d, signed_area_2d, simplify_convex, HalfPlane,
+    clip_polygon_2d, clip_polygon_3d, inside_convex, signed_area_2d, simplify_convex, HalfPlane,
 };
 use crate::geom::{Frame, Plane};
 use crate::scene::solids::Occluder;
@@ -180,6 +180,7 @@ pub fn shadow_polygons(
     let tree = BoxTree::new(faces.iter().map(|f| Aabb::from_points(&f.verts)).collect());
     let outlines: Vec<(Vec<DVec3>, Vec<[DVec3; 2]>)> =
         occs.iter().map(|o| occluder_outline(o, faces)).collect();
+    let buried = crate::buried::burial(scene, eps);
     let mut stats = EdgeStats::default();
     let mut per_receiver: Vec<ReceiverShadows> = (0..faces.len())
         .map(|i| ReceiverShadows {
@@ -200,7 +201,12 @@ pub fn shadow_polygons(
         let volumes: Vec<Vec<ShadowVolumes>> = occs
             .par_iter()
             .enumerate()
-            .map(|(oi, o)| occluder_volumes(&light.kind, None, oi as u32, o, faces, eps))
+            .map(|(oi, o)| {
+                if buried.occluders[oi] {
+                    return Vec::new();
+                }
+                occluder_volumes(&light.kind, None, oi as u32, o, faces, eps)
+            })
             .collect();
         stats.shadow_pairs += volumes.iter().filter(|v| !v.is_empty()).count() as u64;
         stats.culled_pairs += volumes.iter().filter(|v| v.is_empty()).count() as u64;
@@ -249,6 +255,9 @@ pub fn shadow_polygons(
             .par_iter()
             .enumerate()
             .map(|(ri, r)| {
+                if buried.faces[ri] {
+                    return OnReceiver::hidden();
+                }
                 receiver_polygons(
                     li as u32,
                     &light.kind,
@@ -288,9 +297,11 @@ pub fn shadow_polygons(
         stats.t_isr += t1.elapsed().as_secs_f64();
     }
     let t2 = std::time::Instant::now();
-    per_receiver
-        .par_iter_mut()
-        .for_each(|r| crate::umbra_cover::drop_covered(&mut r.polys));
+    per_receiver.par_iter_mut().zip(faces).for_each(|(r, f)| {
+        crate::umbra_cover::drop_covered(&mut r.polys, &r.inside);
+        let snap = 1e-9 * f.extent(scene.diagonal());
+        crate::umbra_cover::trim_lines(r, snap);
+    });
     stats.t_isr += t2.elapsed().as_secs_f64();
     Ok((per_receiver, stats))
 }
@@ -382,6 +393,29 @@ fn receiver_polygons(
             if let Some(p) = inside_solid(solid, r, eps) {
                 inside.push(p);
             }
+        }
+    }
+    for &oi in hits {
+        if outlines[oi as usize]
+            .0
+            .iter()
+            .all(|v| r.plane.dist(*v) <= eps)
+        {
+            continue;
+        }
+        // A shadow that falls wholly inside solids on this receiver decides nothing
+        // (`umbra_cover::drop_covered` would drop it); nor do the critical lines in it. The
+        // shadow under the light cut down to the receiver's front lies inside it.
+        let whole = volumes[oi as usize]
+            .iter()
+            .flat_map(|sv| &sv.penumbra)
+            .filter_map(|p| clip_to_volume(r, p, eps));
+        if whole.into_iter().all(|p| {
+            inside
+                .iter()
+                .any(|q: &Vec<DVec2>| p.iter().all(|&v| inside_convex(q, v)))
+        }) {
+            continue;
         }
         let recomputed;
         let svs: &[ShadowVolumes] = match &clipped_light {

@@ -6,6 +6,7 @@
 
 pub mod arrangement;
 pub mod bake;
+pub mod buried;
 pub mod covered;
 pub mod cuts;
 pub mod direct;

@@ -142,11 +142,11 @@ pub fn build_regions(
         );
     }
     let t0 = std::time::Instant::now();
-    let extent = receiver_extent(r, diag);
+    let extent = r.extent(diag);
     let snap = 1e-9 * extent;
     // Parts of edges deep inside an umbra of their own light would only be dropped again
     // after the arrangement; a few snap distances keep rounding off the umbra boundaries.
-    let cover = UmbraCover::new(&sh.polys, 8.0 * snap);
+    let cover = UmbraCover::new(&sh.polys, &sh.inside, &sh.exposure, 8.0 * snap);
     let (mut scratch, mut pieces) = (Vec::new(), Vec::new());
     let mut segs = Vec::new();
     for (k, p) in sh.polys.iter().enumerate() {
@@ -155,7 +155,14 @@ pub fn build_regions(
             let b = p.poly[(i + 1) % p.poly.len()];
             if a != b && !on_boundary(&r.poly2, a, b, 1e-10 * diag) {
                 pieces.clear();
-                cover.uncovered(a, b, p.light, Some(k as u32), &mut scratch, &mut pieces);
+                cover.uncovered(
+                    a,
+                    b,
+                    Some(p.light),
+                    Some(k as u32),
+                    &mut scratch,
+                    &mut pieces,
+                );
                 segs.extend(pieces.iter().map(|&(a, b)| Segment {
                     a,
                     b,
@@ -167,14 +174,14 @@ pub fn build_regions(
     let n_polys = sh.polys.len() as u32;
     for (k, (l, [a, b])) in sh.events.iter().enumerate() {
         pieces.clear();
-        cover.uncovered(*a, *b, *l, None, &mut scratch, &mut pieces);
+        cover.uncovered(*a, *b, Some(*l), None, &mut scratch, &mut pieces);
         segs.extend(pieces.iter().map(|&(a, b)| Segment {
             a,
             b,
             tag: n_polys + k as u32,
         }));
     }
-    // Plane cuts are kept whole: they belong to every light, so no one umbra covers them.
+    // Plane cuts were cut in `edges` already (`umbra_cover::trim_lines`).
     let n_events = sh.events.len() as u32;
     for (k, [a, b]) in sh.plane_cuts.iter().enumerate() {
         segs.push(Segment {
@@ -271,21 +278,11 @@ pub fn build_regions(
     )
 }
 
-/// The receiver's size (its farthest vertex from the first), never below 1e-9 of the scene:
-/// the arrangement's snapping distance is relative to it.
-fn receiver_extent(r: &Face, diag: f64) -> f64 {
-    r.poly2
-        .iter()
-        .map(|p| (*p - r.poly2[0]).length())
-        .fold(0.0, f64::max)
-        .max(diag * 1e-9)
-}
-
 /// The whole receiver as one region, for uniform meshing: every light that reaches it is
 /// treated as penumbra with every occluder that shadows any part of it as candidate, so the
 /// light at each vertex is still exact.
 fn uniform_regions(r: &Face, sh: &ReceiverShadows, diag: f64) -> ReceiverRegions {
-    let extent = receiver_extent(r, diag);
+    let extent = r.extent(diag);
     let arr = arrangement::build(&r.poly2, &[], 1e-9 * extent);
     let n = sh.exposure.len();
     let mut rf = RegionFace {

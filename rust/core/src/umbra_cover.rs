@@ -11,20 +11,27 @@
 //! polygon of its light (cut where it crosses the boundary, so the pieces left end on it),
 //! and only when some of it lies inside by more than `margin` (distance to every edge line):
 //! rounding can never remove a piece of edge that runs along an umbra boundary.
+//!
+//! The parts of a receiver inside closed solids (`ReceiverShadows::inside`) are umbra of
+//! every light, so they cover like an umbra of each light. Lines that belong to every light
+//! (plane cuts, contacts) are covered by them, and by the umbrae of the one light that
+//! reaches the receiver when only one does. Where solids interpenetrate (clutter heaped on
+//! a table) these are most of the lines.
 
 use glam::DVec2;
 
-use crate::edges::ShadowPolygon;
+use crate::edges::{Exposure, ReceiverShadows, ShadowPolygon};
 use crate::geom::box_grid::{bounds, BoxGrid};
 use crate::geom::polygon::{inside_convex, signed_area_2d};
 
 /// Removes from `polys` every polygon that lies inside another (kept) umbra polygon of the
-/// same light. Of several equal umbra polygons the first is kept.
-pub fn drop_covered(polys: &mut Vec<ShadowPolygon>) {
+/// same light, or inside one of `inside` (parts of the receiver inside solids). Of several
+/// equal umbra polygons the first is kept.
+pub fn drop_covered(polys: &mut Vec<ShadowPolygon>, inside: &[Vec<DVec2>]) {
     let umbrae: Vec<u32> = (0..polys.len() as u32)
         .filter(|&i| polys[i as usize].umbra)
         .collect();
-    if umbrae.is_empty() || polys.len() < 2 {
+    if (umbrae.is_empty() || polys.len() < 2) && inside.is_empty() {
         return;
     }
     let boxes: Vec<(DVec2, DVec2)> = umbrae
@@ -33,26 +40,37 @@ pub fn drop_covered(polys: &mut Vec<ShadowPolygon>) {
         .collect();
     let area: Vec<f64> = polys.iter().map(|p| signed_area_2d(&p.poly)).collect();
     let grid = BoxGrid::new(&boxes);
+    let inside_boxes: Vec<(DVec2, DVec2)> = inside.iter().map(|p| bounds(p)).collect();
+    let inside_grid = BoxGrid::new(&inside_boxes);
     let mut cand = Vec::new();
     let keep: Vec<bool> = (0..polys.len())
         .map(|i| {
             let p = &polys[i];
             let (lo, hi) = bounds(&p.poly);
+            let holds = |(ulo, uhi): (DVec2, DVec2), q: &[DVec2]| {
+                ulo.x <= lo.x
+                    && ulo.y <= lo.y
+                    && uhi.x >= hi.x
+                    && uhi.y >= hi.y
+                    && p.poly.iter().all(|&v| inside_convex(q, v))
+            };
+            inside_grid.meeting(lo, hi, &mut cand);
+            if cand
+                .iter()
+                .any(|&k| holds(inside_boxes[k as usize], &inside[k as usize]))
+            {
+                return false;
+            }
             grid.meeting(lo, hi, &mut cand);
             !cand.iter().any(|&u| {
                 let j = umbrae[u as usize] as usize;
-                let (ulo, uhi) = boxes[u as usize];
                 let q = &polys[j];
                 // A larger umbra, or an equal one earlier in the list (equal areas and
                 // mutual containment mean the same polygon: one of them must stay).
                 j != i
                     && q.light == p.light
-                    && ulo.x <= lo.x
-                    && ulo.y <= lo.y
-                    && uhi.x >= hi.x
-                    && uhi.y >= hi.y
                     && (area[j] > area[i] || (area[j] == area[i] && j < i))
-                    && p.poly.iter().all(|&v| inside_convex(&q.poly, v))
+                    && holds(boxes[u as usize], &q.poly)
             })
         })
         .collect();
@@ -63,60 +81,113 @@ pub fn drop_covered(polys: &mut Vec<ShadowPolygon>) {
     });
 }
 
-/// The umbra polygons of one receiver, for cutting segments.
+/// Cuts the lines that belong to every light on one receiver (plane cuts, contacts) where
+/// they lie deep inside a part covered for every light (see `UmbraCover`), and critical
+/// lines where they lie deep inside an umbra of their light. `snap` is the arrangement's
+/// snapping distance on this receiver.
+pub fn trim_lines(sh: &mut ReceiverShadows, snap: f64) {
+    if sh.inside.is_empty() && sh.polys.is_empty() {
+        return;
+    }
+    let cover = UmbraCover::new(&sh.polys, &sh.inside, &sh.exposure, 8.0 * snap);
+    let (mut scratch, mut pieces) = (Vec::new(), Vec::new());
+    let mut cut = |lines: &[[DVec2; 2]], light: Option<u32>| -> Vec<[DVec2; 2]> {
+        let mut out = Vec::with_capacity(lines.len());
+        for &[a, b] in lines {
+            pieces.clear();
+            cover.uncovered(a, b, light, None, &mut scratch, &mut pieces);
+            out.extend(pieces.iter().map(|&(a, b)| [a, b]));
+        }
+        out
+    };
+    let plane_cuts = cut(&sh.plane_cuts, None);
+    let contacts = cut(&sh.contacts, None);
+    let mut events = Vec::with_capacity(sh.events.len());
+    for &(l, e) in &sh.events {
+        events.extend(cut(&[e], Some(l)).into_iter().map(|e| (l, e)));
+    }
+    sh.plane_cuts = plane_cuts;
+    sh.contacts = contacts;
+    sh.events = events;
+}
+
+/// The covers of one receiver, for cutting segments: the umbra polygons of each light, and
+/// the parts inside solids, which cover for every light.
 pub struct UmbraCover<'a> {
-    polys: &'a [ShadowPolygon],
-    umbrae: Vec<u32>,
+    /// Polygon, the light it covers (`None`: every light) and the shadow polygon it is.
+    covers: Vec<(&'a [DVec2], Option<u32>, Option<u32>)>,
+    /// The one light that reaches the receiver, when only one does: its umbrae then cover
+    /// the lines that belong to every light too.
+    only_light: Option<u32>,
     grid: BoxGrid,
     margin: f64,
 }
 
 impl<'a> UmbraCover<'a> {
-    pub fn new(polys: &'a [ShadowPolygon], margin: f64) -> Self {
-        let umbrae: Vec<u32> = (0..polys.len() as u32)
+    pub fn new(
+        polys: &'a [ShadowPolygon],
+        inside: &'a [Vec<DVec2>],
+        exposure: &[Exposure],
+        margin: f64,
+    ) -> Self {
+        let covers: Vec<(&[DVec2], Option<u32>, Option<u32>)> = (0..polys.len() as u32)
             .filter(|&i| polys[i as usize].umbra && polys[i as usize].poly.len() >= 3)
+            .map(|i| {
+                let p = &polys[i as usize];
+                (p.poly.as_slice(), Some(p.light), Some(i))
+            })
+            .chain(
+                inside
+                    .iter()
+                    .filter(|p| p.len() >= 3)
+                    .map(|p| (p.as_slice(), None, None)),
+            )
             .collect();
-        let boxes: Vec<(DVec2, DVec2)> = umbrae
-            .iter()
-            .map(|&i| bounds(&polys[i as usize].poly))
-            .collect();
+        let boxes: Vec<(DVec2, DVec2)> = covers.iter().map(|c| bounds(c.0)).collect();
+        let mut reaching =
+            (0..exposure.len() as u32).filter(|&l| exposure[l as usize] != Exposure::Hidden);
+        let only_light = match (reaching.next(), reaching.next()) {
+            (Some(l), None) => Some(l),
+            _ => None,
+        };
         UmbraCover {
-            polys,
-            umbrae,
+            covers,
+            only_light,
             grid: BoxGrid::new(&boxes),
             margin,
         }
     }
 
-    /// The pieces of segment `a`–`b` (an edge made by `light`, from polygon `own` if any)
-    /// that are not deep inside an umbra polygon of that light, appended to `out`.
+    /// The pieces of segment `a`–`b` (an edge made by `light`, or by every light when
+    /// `None`; from polygon `own` if any) that are not deep inside a cover of that light,
+    /// appended to `out`.
     pub fn uncovered(
         &self,
         a: DVec2,
         b: DVec2,
-        light: u32,
+        light: Option<u32>,
         own: Option<u32>,
         scratch: &mut Vec<u32>,
         out: &mut Vec<(DVec2, DVec2)>,
     ) {
-        if self.umbrae.is_empty() {
+        if self.covers.is_empty() {
             out.push((a, b));
             return;
         }
+        let light = light.or(self.only_light);
         self.grid.meeting(a.min(b), a.max(b), scratch);
         let mut cut: Vec<(f64, f64)> = Vec::new();
         let d = b - a;
         for &u in scratch.iter() {
-            let j = self.umbrae[u as usize];
-            let q = &self.polys[j as usize];
-            if q.light != light || Some(j) == own {
+            let (q, l, j) = self.covers[u as usize];
+            if (l.is_some() && l != light) || (j.is_some() && j == own) {
                 continue;
             }
             // Decided with the margin, cut where the segment crosses the boundary: the
-            // pieces left then end on the umbra's edges (the arrangement snaps them there)
+            // pieces left then end on the cover's edges (the arrangement snaps them there)
             // instead of leaving stubs inside that would stay as dangling edges.
-            if let Some(deep) = deep_inside(&q.poly, a, d, self.margin) {
-                cut.push(deep_inside(&q.poly, a, d, 0.0).unwrap_or(deep));
+            if let Some(deep) = deep_inside(q, a, d, self.margin) {
+                cut.push(deep_inside(q, a, d, 0.0).unwrap_or(deep));
             }
         }
         if cut.is_empty() {
@@ -205,7 +276,7 @@ mod test {
             // Touching the boundary from inside is inside.
             sq(0.0, 0.0, 1.0, 0.5, false, 5),
         ];
-        drop_covered(&mut polys);
+        drop_covered(&mut polys, &[]);
         let left: Vec<u32> = polys.iter().map(|p| p.occluder).collect();
         assert_eq!(left, vec![0, 2, 3]);
     }
@@ -216,11 +287,11 @@ mod test {
             sq(0.0, 0.0, 1.0, 1.0, true, 0),
             sq(2.0, 0.0, 3.0, 1.0, true, 1),
         ];
-        let cover = UmbraCover::new(&polys, 1e-9);
+        let cover = UmbraCover::new(&polys, &[], &[Exposure::Regions; 2], 1e-9);
         let (mut s, mut out) = (Vec::new(), Vec::new());
         // Through both squares: the three pieces outside them, ending on their boundaries.
         let (a, b) = (DVec2::new(-1.0, 0.5), DVec2::new(4.0, 0.5));
-        cover.uncovered(a, b, 0, None, &mut s, &mut out);
+        cover.uncovered(a, b, Some(0), None, &mut s, &mut out);
         assert_eq!(out.len(), 3);
         assert!(out[0].1.x.abs() < 1e-15 && (out[1].0.x - 1.0).abs() < 1e-15);
         // Along the square's edge, or from another light: untouched.
@@ -229,7 +300,7 @@ mod test {
             (DVec2::new(-1.0, 0.5), DVec2::new(4.0, 0.5), 1),
         ] {
             out.clear();
-            cover.uncovered(a, b, l, None, &mut s, &mut out);
+            cover.uncovered(a, b, Some(l), None, &mut s, &mut out);
             assert_eq!(out, vec![(a, b)]);
         }
         // Wholly inside: nothing left.
@@ -237,7 +308,7 @@ mod test {
         cover.uncovered(
             DVec2::new(0.2, 0.2),
             DVec2::new(0.8, 0.3),
-            0,
+            Some(0),
             None,
             &mut s,
             &mut out,

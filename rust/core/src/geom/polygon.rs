@@ -80,6 +80,45 @@ pub fn clip_polygon_2d(poly: &[DVec2], h: &HalfPlane, eps: f64) -> Vec<DVec2> {
     out
 }
 
+/// Convex counter-clockwise `piece` minus convex counter-clockwise `c`, as disjoint convex
+/// pieces appended to `out`: for each edge of `c`, the part of `piece` outside that edge and
+/// inside the edges before it. Pieces of area at most `min_area` (clipping slivers) are left
+/// out. A piece whose bounds miss `c`'s bounds stays whole.
+pub fn subtract_convex(piece: Vec<DVec2>, c: &[DVec2], min_area: f64, out: &mut Vec<Vec<DVec2>>) {
+    let (lo, hi) = crate::geom::box_grid::bounds(c);
+    let (plo, phi) = crate::geom::box_grid::bounds(&piece);
+    if phi.x <= lo.x || phi.y <= lo.y || plo.x >= hi.x || plo.y >= hi.y {
+        out.push(piece);
+        return;
+    }
+    let n = c.len();
+    let mut rest = piece;
+    for k in 0..n {
+        let (a, b) = (c[k], c[(k + 1) % n]);
+        let nrm = (b - a).perp();
+        // A repeated vertex: no edge, no side.
+        if nrm == DVec2::ZERO {
+            continue;
+        }
+        let inside = HalfPlane {
+            n: nrm,
+            c: nrm.dot(a),
+        };
+        let outside = HalfPlane {
+            n: -nrm,
+            c: -inside.c,
+        };
+        let part = clip_polygon_2d(&rest, &outside, 0.0);
+        if part.len() >= 3 && signed_area_2d(&part) > min_area {
+            out.push(part);
+        }
+        rest = clip_polygon_2d(&rest, &inside, 0.0);
+        if rest.len() < 3 {
+            return;
+        }
+    }
+}
+
 /// Signed area (positive when counter-clockwise).
 pub fn signed_area_2d(poly: &[DVec2]) -> f64 {
     let n = poly.len();

@@ -29,6 +29,18 @@ pub struct Face {
     pub area: f64,
 }
 
+impl Face {
+    /// The face's size (its farthest vertex from the first), never below 1e-9 of the scene
+    /// diagonal `diag`: the arrangement's snapping distance is relative to it.
+    pub fn extent(&self, diag: f64) -> f64 {
+        self.poly2
+            .iter()
+            .map(|p| (*p - self.poly2[0]).length())
+            .fold(0.0, f64::max)
+            .max(diag * 1e-9)
+    }
+}
+
 #[derive(Debug, Clone)]
 pub struct MeshInfo {
     pub name: String,
