@@ -137,7 +137,9 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
         .faces
         .par_iter()
         .zip(&shadows)
-        .map(|(f, sh)| regions::build_regions(f, sh, diag, scene.settings.uniform))
+        .map(|(f, sh)| {
+            regions::build_regions(f, sh, diag, scene.settings.uniform, scene.settings.indirect)
+        })
         .collect();
     // Stage times are wall time, split between sub-stages by their share of CPU time.
     let wall = t.elapsed().as_secs_f64();

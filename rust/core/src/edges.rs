@@ -300,7 +300,7 @@ pub fn shadow_polygons(
     per_receiver.par_iter_mut().zip(faces).for_each(|(r, f)| {
         crate::umbra_cover::drop_covered(&mut r.polys, &r.inside);
         let snap = 1e-9 * f.extent(scene.diagonal());
-        crate::umbra_cover::trim_lines(r, snap);
+        crate::umbra_cover::trim_lines(r, snap, !scene.settings.indirect);
     });
     stats.t_isr += t2.elapsed().as_secs_f64();
     Ok((per_receiver, stats))

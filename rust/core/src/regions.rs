@@ -129,6 +129,7 @@ pub fn build_regions(
     sh: &ReceiverShadows,
     diag: f64,
     uniform: bool,
+    indirect: bool,
 ) -> (ReceiverRegions, RegionTimes) {
     if uniform {
         return (
@@ -183,7 +184,10 @@ pub fn build_regions(
     }
     // Plane cuts were cut in `edges` already (`umbra_cover::trim_lines`).
     let n_events = sh.events.len() as u32;
-    for (k, [a, b]) in sh.plane_cuts.iter().enumerate() {
+    // Contacts too when indirect light follows: where a solid meets the receiver in umbra on
+    // both sides, bounced light still reaches the side outside it and never the inside.
+    let contacts: &[[DVec2; 2]] = if indirect { &sh.contacts } else { &[] };
+    for (k, [a, b]) in sh.plane_cuts.iter().chain(contacts).enumerate() {
         segs.push(Segment {
             a: *a,
             b: *b,
@@ -217,7 +221,8 @@ pub fn build_regions(
             }
         }
     }
-    // The light an edge belongs to; `None` for a plane cut, which belongs to every light.
+    // The light an edge belongs to; `None` for a plane cut or contact, which belongs to
+    // every light.
     let light_of = |t: u32| {
         if t < n_polys {
             Some(sh.polys[t as usize].light)
@@ -246,6 +251,8 @@ pub fn build_regions(
                 };
                 match light_of(t) {
                     Some(l) => both_umbra(l as usize),
+                    // Solid on one side, open floor on the other: indirect light differs.
+                    None if indirect => false,
                     None => (0..n_lights).all(both_umbra),
                 }
             });

@@ -14,9 +14,10 @@
 //!
 //! The parts of a receiver inside closed solids (`ReceiverShadows::inside`) are umbra of
 //! every light, so they cover like an umbra of each light. Lines that belong to every light
-//! (plane cuts, contacts) are covered by them, and by the umbrae of the one light that
-//! reaches the receiver when only one does. Where solids interpenetrate (clutter heaped on
-//! a table) these are most of the lines.
+//! (plane cuts, contacts) are covered by them, and, for a bake of direct light only, by the
+//! umbrae of the one light that reaches the receiver when only one does. (Indirect light
+//! still jumps across a contact in umbra: zero under the box, bounced light beside it.)
+//! Where solids interpenetrate (clutter heaped on a table) these are most of the lines.
 
 use glam::DVec2;
 
@@ -84,12 +85,15 @@ pub fn drop_covered(polys: &mut Vec<ShadowPolygon>, inside: &[Vec<DVec2>]) {
 /// Cuts the lines that belong to every light on one receiver (plane cuts, contacts) where
 /// they lie deep inside a part covered for every light (see `UmbraCover`), and critical
 /// lines where they lie deep inside an umbra of their light. `snap` is the arrangement's
-/// snapping distance on this receiver.
-pub fn trim_lines(sh: &mut ReceiverShadows, snap: f64) {
+/// snapping distance on this receiver; `direct_only`: no indirect light will be computed.
+pub fn trim_lines(sh: &mut ReceiverShadows, snap: f64, direct_only: bool) {
     if sh.inside.is_empty() && sh.polys.is_empty() {
         return;
     }
-    let cover = UmbraCover::new(&sh.polys, &sh.inside, &sh.exposure, 8.0 * snap);
+    let mut cover = UmbraCover::new(&sh.polys, &sh.inside, &sh.exposure, 8.0 * snap);
+    if !direct_only {
+        cover.only_light = None;
+    }
     let (mut scratch, mut pieces) = (Vec::new(), Vec::new());
     let mut cut = |lines: &[[DVec2; 2]], light: Option<u32>| -> Vec<[DVec2; 2]> {
         let mut out = Vec::with_capacity(lines.len());

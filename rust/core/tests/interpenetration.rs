@@ -494,3 +494,46 @@ fn reference_is_unoccluded_closed_form() {
     let want = 4.0 * std::f64::consts::PI * f;
     assert!((e - want).abs() <= 1e-6 * want, "{e} vs {want}");
 }
+
+/// With indirect light on, a box's foot stays an edge of the floor's mesh even where it
+/// lies in umbra on both sides: bounced light reaches the floor beside the box and never
+/// the floor under it, so no floor triangle may straddle the foot.
+#[test]
+fn feet_stay_in_the_mesh_for_indirect_light() {
+    let floor = mesh("Floor", vec![quad([0.0, 0.0, 0.0], 2.0, 2.0, true)]);
+    let cube = mesh("Cube", cuboid([-0.3, -0.3, 0.0], [0.3, 0.3, 0.6]));
+    // One small light off to +x: the cube's -x foot is in its umbra on both sides.
+    let light = area_light("Lamp", quad([1.5, 0.0, 3.0], 0.1, 0.1, false));
+    let settings = SettingsJson {
+        element_size: Some(0.25),
+        convergence: Some(0.05),
+        ..Default::default()
+    };
+    let b = bake(&scene(vec![floor, cube], vec![light], settings));
+    let f = b
+        .meshes
+        .iter()
+        .find(|m| m.name == "Floor")
+        .expect("floor baked");
+    let side = |p: [f64; 3]| -> i32 {
+        let d = 0.3 - p[0].abs().max(p[1].abs());
+        if d > 1e-9 {
+            1
+        } else if d < -1e-9 {
+            -1
+        } else {
+            0
+        }
+    };
+    let mut on_foot = 0;
+    for t in &f.triangles {
+        let s = t.map(|v| side(f.positions[v as usize]));
+        assert!(
+            !(s.contains(&1) && s.contains(&-1)),
+            "triangle {:?} straddles the cube's foot",
+            t.map(|v| f.positions[v as usize])
+        );
+        on_foot += s.contains(&0) as usize;
+    }
+    assert!(on_foot > 8);
+}
