@@ -32,7 +32,7 @@ use crate::scene::Face;
 const CORNER_TURN: f64 = 0.35;
 /// Interpolated values whose two interpolants differ by more than this fraction of the
 /// largest value they use are computed instead (`Gather::spread`).
-const UNSURE: f64 = 0.01;
+const UNSURE: f64 = 0.03;
 /// Near a contact the spacing is at most this times the distance to it (`spacings`).
 const GRADE: f64 = 0.5;
 
