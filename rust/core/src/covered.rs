@@ -22,10 +22,15 @@ pub struct Open {
 /// piece, itself, without cuts; a face covered whole has none. `tol` is the distance under
 /// which two planes count as the same.
 pub fn open_parts(faces: &[Face], tol: f64) -> Vec<Vec<Open>> {
+    open_parts_of(faces, &covers(faces, tol), tol)
+}
+
+/// `open_parts` from the faces' `covers` (as `covers` gives them).
+pub fn open_parts_of(faces: &[Face], covers: &[Vec<Vec<DVec2>>], tol: f64) -> Vec<Vec<Open>> {
     let tol = tol.max(f64::MIN_POSITIVE);
     faces
         .iter()
-        .zip(covers(faces, tol))
+        .zip(covers)
         .map(|(f, covers)| {
             let whole = vec![Open {
                 poly: f.poly2.clone(),

@@ -116,7 +116,9 @@ fn indirect_at(
             format!("{} values for {nv} element vertices", direct.len()),
         ));
     }
-    let open = crate::covered::open_parts(&scene.faces, 1e-6 * scene.diagonal());
+    let cover_tol = 1e-6 * scene.diagonal();
+    let covers = crate::covered::covers(&scene.faces, cover_tol);
+    let open = crate::covered::open_parts_of(&scene.faces, &covers, cover_tol);
     let patches = build_patches(
         &scene.faces,
         &open,
@@ -143,7 +145,6 @@ fn indirect_at(
 
     // D0-row copies sit at least 1e-9 of the scene off their line (`mesh`), so a tenth of
     // that tells their side from the line itself.
-    let covers = crate::covered::covers(&scene.faces, 1e-6 * scene.diagonal());
     let gather = Gather::new(&scene.faces, &covers, el, spacing, 1e-10 * scene.diagonal());
     result.gather_vertices = gather.kept_count() as u64;
     let shooter = Shooter::new(scene, el, &patches, occ, emitted, &gather);

@@ -147,7 +147,8 @@ pub fn build_regions(
     let snap = 1e-9 * extent;
     // Parts of edges deep inside an umbra of their own light would only be dropped again
     // after the arrangement; a few snap distances keep rounding off the umbra boundaries.
-    let cover = UmbraCover::new(&sh.polys, &sh.inside, &sh.exposure, 8.0 * snap);
+    // Every segment cut here carries its light, so the only-light rule never applies.
+    let cover = UmbraCover::new(&sh.polys, &sh.inside, &sh.exposure, 8.0 * snap, false);
     let (mut scratch, mut pieces) = (Vec::new(), Vec::new());
     let mut segs = Vec::new();
     for (k, p) in sh.polys.iter().enumerate() {

@@ -90,10 +90,7 @@ pub fn trim_lines(sh: &mut ReceiverShadows, snap: f64, direct_only: bool) {
     if sh.inside.is_empty() && sh.polys.is_empty() {
         return;
     }
-    let mut cover = UmbraCover::new(&sh.polys, &sh.inside, &sh.exposure, 8.0 * snap);
-    if !direct_only {
-        cover.only_light = None;
-    }
+    let cover = UmbraCover::new(&sh.polys, &sh.inside, &sh.exposure, 8.0 * snap, direct_only);
     let (mut scratch, mut pieces) = (Vec::new(), Vec::new());
     let mut cut = |lines: &[[DVec2; 2]], light: Option<u32>| -> Vec<[DVec2; 2]> {
         let mut out = Vec::with_capacity(lines.len());
@@ -133,6 +130,7 @@ impl<'a> UmbraCover<'a> {
         inside: &'a [Vec<DVec2>],
         exposure: &[Exposure],
         margin: f64,
+        only_light_covers_lines: bool,
     ) -> Self {
         let covers: Vec<(&[DVec2], Option<u32>, Option<u32>)> = (0..polys.len() as u32)
             .filter(|&i| polys[i as usize].umbra && polys[i as usize].poly.len() >= 3)
@@ -151,7 +149,7 @@ impl<'a> UmbraCover<'a> {
         let mut reaching =
             (0..exposure.len() as u32).filter(|&l| exposure[l as usize] != Exposure::Hidden);
         let only_light = match (reaching.next(), reaching.next()) {
-            (Some(l), None) => Some(l),
+            (Some(l), None) if only_light_covers_lines => Some(l),
             _ => None,
         };
         UmbraCover {
@@ -291,7 +289,7 @@ mod test {
             sq(0.0, 0.0, 1.0, 1.0, true, 0),
             sq(2.0, 0.0, 3.0, 1.0, true, 1),
         ];
-        let cover = UmbraCover::new(&polys, &[], &[Exposure::Regions; 2], 1e-9);
+        let cover = UmbraCover::new(&polys, &[], &[Exposure::Regions; 2], 1e-9, false);
         let (mut s, mut out) = (Vec::new(), Vec::new());
         // Through both squares: the three pieces outside them, ending on their boundaries.
         let (a, b) = (DVec2::new(-1.0, 0.5), DVec2::new(4.0, 0.5));

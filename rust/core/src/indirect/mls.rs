@@ -108,6 +108,11 @@ pub(super) fn shepard(x: DVec2, cands: &[u32], uv: &[DVec2], out: &mut Vec<(u32,
 mod test {
     use super::*;
 
+    /// The weights `w` applied to `f` at the points.
+    fn apply(w: &[(u32, f64)], pts: &[DVec2], f: impl Fn(DVec2) -> f64) -> f64 {
+        w.iter().map(|&(k, l)| l * f(pts[k as usize])).sum()
+    }
+
     #[test]
     fn fit_reproduces_a_linear_field() {
         let pts = [
@@ -122,7 +127,7 @@ mod test {
         let x = DVec2::new(0.3, 0.2);
         let mut w = Vec::new();
         assert!(fit::<3>(x, &cands, &pts, &mut w));
-        let got: f64 = w.iter().map(|&(k, l)| l * f(pts[k as usize])).sum();
+        let got = apply(&w, &pts, f);
         assert!((got - f(x)).abs() < 1e-12, "{got} vs {}", f(x));
         let total: f64 = w.iter().map(|e| e.1).sum();
         assert!((total - 1.0).abs() < 1e-12);
@@ -142,7 +147,7 @@ mod test {
         let x = DVec2::new(0.1, -0.2);
         let mut w = Vec::new();
         assert!(fit::<6>(x, &cands, &pts, &mut w));
-        let got: f64 = w.iter().map(|&(k, l)| l * f(pts[k as usize])).sum();
+        let got = apply(&w, &pts, f);
         assert!((got - f(x)).abs() < 1e-11, "{got} vs {}", f(x));
     }
 

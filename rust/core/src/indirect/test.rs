@@ -94,6 +94,15 @@ fn form_factor_matches_closed_forms() {
     assert_eq!(form_factor(v(0., 0., 2.), -DVec3::Z, &sq), 0.0);
 }
 
+/// A black 2×2 emitter of radiance `le` at height `h` facing down, over a 2×2 receiver of
+/// albedo `rho` at z = 0 facing up.
+fn plates(h: f64, le: DVec3, rho: f64) -> [Face; 2] {
+    [
+        quad(v(0., 0., h), DVec3::Y, DVec3::X, 0.0, le),
+        quad(DVec3::ZERO, DVec3::X, DVec3::Y, rho, DVec3::ZERO),
+    ]
+}
+
 /// Form factor from a point `x` on the plane z = 0 to the 2×2 square centred above the
 /// origin at height `h`, facing down: four corner rectangles.
 fn plate_factor(x: DVec3, h: f64) -> f64 {
@@ -107,8 +116,7 @@ fn parallel_plates_match_closed_form() {
     // emitter is black, so nothing comes back; the receiver gets π·Le·F exactly.
     let h = 0.7;
     let le = v(1.0, 2.0, 0.5);
-    let emitter = quad(v(0., 0., h), DVec3::Y, DVec3::X, 0.0, le);
-    let receiver = quad(DVec3::ZERO, DVec3::X, DVec3::Y, 0.6, DVec3::ZERO);
+    let [emitter, receiver] = plates(h, le, 0.6);
     let sc = scene(vec![emitter, receiver], |s| {
         s.patch_size = 0.8;
         s.convergence = 1e-6;
@@ -142,8 +150,7 @@ fn interpolated_vertices_match_closed_form_between_plates() {
     // are interpolated, and still within a small fraction of the exact factor.
     let h = 0.7;
     let le = DVec3::ONE;
-    let emitter = quad(v(0., 0., h), DVec3::Y, DVec3::X, 0.0, le);
-    let receiver = quad(DVec3::ZERO, DVec3::X, DVec3::Y, 0.6, DVec3::ZERO);
+    let [emitter, receiver] = plates(h, le, 0.6);
     let sc = scene(vec![emitter, receiver], |s| {
         s.element_size = 0.3;
         s.patch_size = 0.4;
@@ -243,8 +250,7 @@ fn no_light_leaks_under_a_box_through_the_interpolation() {
 fn blocker_between_plates_casts_full_shadow() {
     let h = 1.0;
     let le = DVec3::ONE;
-    let emitter = quad(v(0., 0., h), DVec3::Y, DVec3::X, 0.0, le);
-    let receiver = quad(DVec3::ZERO, DVec3::X, DVec3::Y, 0.5, DVec3::ZERO);
+    let [emitter, receiver] = plates(h, le, 0.5);
     // Facing up: it only sends light back up, the receiver sits in its shadow.
     let blocker = quad(
         v(0., 0., 0.5),
