@@ -10,14 +10,14 @@ use glam::DVec3;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::edges;
-use crate::elements::{Elements, Region};
+use crate::direct;
 use crate::geom::raycast::Occluders;
 use crate::indirect;
+use crate::mesh::elements::{Elements, Region};
+use crate::mesh::sizing::Sizing;
 use crate::mesh::{self, ReceiverMesh};
 use crate::regions::{self, ReceiverRegions, RegionTimes};
-use crate::sizing::Sizing;
-use crate::vertex_light;
+use crate::shadows;
 
 use crate::progress::Progress;
 use crate::scene::json::SceneJson;
@@ -123,7 +123,7 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
     };
 
     progress.stage("shadow volumes");
-    let (shadows, es) = edges::shadow_polygons(scene, progress)?;
+    let (shadows, es) = shadows::shadow_polygons(scene, progress)?;
     stats.T_sdw = es.t_sdw;
     stats.T_isr = es.t_isr;
     stats.shadow_pairs = es.shadow_pairs;
@@ -181,7 +181,7 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
 
     progress.stage("direct light");
     let t = Instant::now();
-    let (direct, pairs) = vertex_light::direct_irradiance(scene, &elements, progress)?;
+    let (direct, pairs) = direct::direct_irradiance(scene, &elements, progress)?;
     stats.T_direct = t.elapsed().as_secs_f64();
     [stats.pairs_umbra, stats.pairs_lit, stats.pairs_penumbra] = pairs;
 

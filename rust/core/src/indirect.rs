@@ -41,8 +41,8 @@ use gather::Gather;
 use receiver::form_factor;
 use shooter::Shooter;
 
-use crate::elements::Elements;
 use crate::geom::raycast::Occluders;
+use crate::mesh::elements::Elements;
 use crate::patches::{build_patches, Patch};
 use crate::progress::Progress;
 use crate::scene::Scene;

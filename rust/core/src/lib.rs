@@ -4,30 +4,20 @@
 //! The pipeline runs one direction: `scene` → `shadow` → `edges` → `arrangement`/`relation`
 //! → `mesh` → `direct` → `indirect` → `bake` (output).
 
-pub mod arrangement;
 pub mod bake;
-pub mod buried;
-pub mod covered;
-pub mod cuts;
 pub mod direct;
-pub mod edges;
-pub mod elements;
 pub mod error;
-pub mod events;
 pub mod geom;
 pub mod indirect;
 pub mod mesh;
-pub mod patches;
 pub mod progress;
 pub mod regions;
-pub mod relation;
 pub mod scene;
-pub mod screens;
-pub mod settings;
-pub mod shadow;
-pub mod sizing;
-pub mod umbra_cover;
-pub mod vertex_light;
+pub mod shadows;
+
+// Moved into `indirect/` by the hierarchical-radiosity work.
+pub mod covered;
+pub mod patches;
 
 pub use bake::{bake, bake_scene_json, Bake, BakedMesh, Stats};
 pub use error::BakeError;

@@ -8,10 +8,10 @@
 use glam::{DVec2, DVec3};
 
 use crate::covered::Open;
-use crate::elements::Elements;
 use crate::geom::polygon::{
     clip_polygon_2d, signed_area_2d, simplify_convex, strictly_inside_convex, HalfPlane,
 };
+use crate::mesh::elements::Elements;
 use crate::scene::Face;
 
 #[derive(Debug, Clone)]

@@ -8,11 +8,11 @@
 mod common;
 use common::*;
 use glam::DVec3;
-use penumbra::direct::area_light as exact_area_light;
+use penumbra::direct::exact::area_light as exact_area_light;
 use penumbra::geom::Plane;
-use penumbra::relation::Relation;
+use penumbra::regions::relation::Relation;
 use penumbra::scene::json::SettingsJson;
-use penumbra::settings::PenumbraVisibility;
+use penumbra::scene::settings::PenumbraVisibility;
 use std::f64::consts::PI;
 
 fn clutter_scene() -> penumbra::SceneJson {

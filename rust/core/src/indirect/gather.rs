@@ -24,7 +24,7 @@ use std::collections::{BinaryHeap, VecDeque};
 use glam::{DVec2, DVec3};
 
 use super::mls::{fit, shepard};
-use crate::elements::Elements;
+use crate::mesh::elements::Elements;
 use crate::scene::Face;
 
 /// Boundary vertices where the border turns by more than this (radians) are always kept:

@@ -11,8 +11,8 @@ use rayon::prelude::*;
 use super::blockers::{Blockers, Pair, Reached};
 use super::gather::Gather;
 use super::{mean, CHUNK, FACTOR_BUDGET};
-use crate::elements::Elements;
 use crate::geom::raycast::Occluders;
+use crate::mesh::elements::Elements;
 use crate::patches::Patch;
 use crate::scene::Scene;
 

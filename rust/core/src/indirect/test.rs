@@ -5,8 +5,8 @@ use crate::geom::raycast::test::face;
 use crate::geom::Plane;
 use crate::patches::test::grid_elements;
 use crate::scene::json::SettingsJson;
+use crate::scene::settings::Settings;
 use crate::scene::Face;
-use crate::settings::Settings;
 
 fn v(x: f64, y: f64, z: f64) -> DVec3 {
     DVec3::new(x, y, z)

@@ -3,13 +3,14 @@
 
 pub mod convex;
 pub mod json;
+pub mod settings;
 pub mod solids;
 pub mod validate;
 
 use glam::{DVec2, DVec3};
 
 use crate::geom::{Frame, Plane};
-use crate::settings::Settings;
+use crate::scene::settings::Settings;
 
 pub use validate::validate;
 

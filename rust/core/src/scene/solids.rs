@@ -10,6 +10,7 @@ use glam::DVec3;
 
 use super::json::MeshJson;
 use super::Face;
+use crate::geom::union_find::UnionFind;
 use crate::geom::Plane;
 
 /// A closed convex polyhedron made of scene faces.
@@ -84,29 +85,19 @@ pub fn find_solids(m: &MeshJson, faces: &[Face], first: usize) -> Vec<Occluder> 
         }
     }
     // Components over shared edges.
-    let mut parent: Vec<u32> = (0..polys.len() as u32).collect();
-    fn find(p: &mut [u32], mut i: u32) -> u32 {
-        while p[i as usize] != i {
-            p[i as usize] = p[p[i as usize] as usize];
-            i = p[i as usize];
-        }
-        i
-    }
+    let mut sets = UnionFind::new(polys.len());
     let mut closed = vec![true; polys.len()];
     for (&(a, b), &pi) in &directed {
         match directed.get(&(b, a)) {
             Some(&qi) => {
-                let (ra, rb) = (find(&mut parent, pi), find(&mut parent, qi));
-                if ra != rb {
-                    parent[ra.max(rb) as usize] = ra.min(rb);
-                }
+                sets.union(pi, qi);
             }
             None => closed[pi as usize] = false,
         }
     }
     let mut comps: HashMap<u32, Vec<u32>> = HashMap::new();
     for pi in 0..polys.len() as u32 {
-        let r = find(&mut parent, pi);
+        let r = sets.find(pi);
         comps.entry(r).or_default().push(pi);
     }
     // Faces of each polygon.

@@ -9,7 +9,7 @@ use super::json::{LightJson, MeshJson, PerPolygon, SceneJson};
 use super::solids::{find_solids, Occluder};
 use super::{Face, Light, LightKind, MeshInfo, Scene, Spot};
 use crate::geom::{Frame, Plane};
-use crate::settings::Settings;
+use crate::scene::settings::Settings;
 use crate::BakeError;
 
 /// Largest coordinate magnitude accepted: far beyond any real scene, small enough that

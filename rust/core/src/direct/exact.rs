@@ -33,9 +33,9 @@ use crate::geom::lambert::{contours_irradiance, polygon_irradiance};
 use crate::geom::plane::newell_normal;
 use crate::geom::polygon::{clip_polygon_3d, inside_convex, signed_area_2d, subtract_convex};
 use crate::geom::{Frame, Plane};
-use crate::relation::Relation;
+use crate::regions::relation::Relation;
+use crate::scene::settings::PenumbraVisibility;
 use crate::scene::Spot;
-use crate::settings::PenumbraVisibility;
 
 /// Distances below this fraction of the configuration's size count as contact (see the
 /// module note): a million times the rounding of f64 coordinates, and small enough that an
@@ -53,10 +53,10 @@ pub const TOUCH: f64 = 1e-10;
 ///
 /// ```
 /// use glam::DVec3;
-/// use penumbra::direct::area_light;
+/// use penumbra::direct::exact::area_light;
 /// use penumbra::geom::Plane;
-/// use penumbra::relation::Relation::{Lit, Penumbra};
-/// use penumbra::settings::PenumbraVisibility::Exact;
+/// use penumbra::regions::relation::Relation::{Lit, Penumbra};
+/// use penumbra::scene::settings::PenumbraVisibility::Exact;
 /// let quad = |x0: f64, x1: f64, y0: f64, y1: f64, z: f64| {
 ///     [(x0, y0), (x1, y0), (x1, y1), (x0, y1)].map(|(x, y)| DVec3::new(x, y, z))
 /// };

@@ -6,8 +6,8 @@
 
 use glam::{DVec2, DVec3};
 
+use crate::scene::settings::Settings;
 use crate::scene::{Face, Light, LightKind};
-use crate::settings::Settings;
 
 /// Elements at most this fraction of the distance to the light.
 const PER_DISTANCE: f64 = 1.0 / 20.0;

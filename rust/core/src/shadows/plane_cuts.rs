@@ -6,10 +6,9 @@
 
 use glam::{DVec2, DVec3};
 
-use crate::edges::clip_to_volume;
 use crate::scene::solids::Solid;
 use crate::scene::Face;
-use crate::shadow::Volume;
+use crate::shadows::volume::{clip_to_volume, Volume};
 
 /// The segment where convex occluder face `verts` crosses receiver `r`'s plane, clipped to
 /// `r`'s polygon, in `r`'s frame. `None` when the face only touches the plane (within

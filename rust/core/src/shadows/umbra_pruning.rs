@@ -21,9 +21,9 @@
 
 use glam::DVec2;
 
-use crate::edges::{Exposure, ReceiverShadows, ShadowPolygon};
 use crate::geom::box_grid::{bounds, BoxGrid};
 use crate::geom::polygon::{inside_convex, signed_area_2d};
+use crate::shadows::polygons::{Exposure, ReceiverShadows, ShadowPolygon};
 
 /// Removes from `polys` every polygon that lies inside another (kept) umbra polygon of the
 /// same light, or inside one of `inside` (parts of the receiver inside solids). Of several

@@ -4,15 +4,19 @@
 //! edge are no discontinuity at all (the mosaic of one closed mesh's face shadows inside its
 //! umbra); they are dropped, so that the mesh conforms only to real boundaries.
 
+pub mod arrangement;
+pub mod relation;
+
 use glam::DVec2;
 
-use crate::arrangement::{self, Arrangement, Segment, BOUNDARY_TAG};
-use crate::edges::{Exposure, ReceiverShadows, ShadowPolygon};
 use crate::geom::box_grid::{bounds, BoxGrid};
 use crate::geom::polygon::inside_convex;
-use crate::relation::Relation;
+use crate::geom::union_find::UnionFind;
+use crate::regions::relation::Relation;
 use crate::scene::Face;
-use crate::umbra_cover::UmbraCover;
+use crate::shadows::umbra_pruning::UmbraCover;
+use crate::shadows::{Exposure, ReceiverShadows, ShadowPolygon};
+use arrangement::{Arrangement, Segment, BOUNDARY_TAG};
 
 /// A face of the arrangement with its light relations.
 #[derive(Debug, Clone)]
@@ -91,7 +95,7 @@ impl<'a> Indexed<'a> {
                 // Keep the occluder: a vertex where umbra meets light without a D0 split
                 // needs it to compute its value exactly.
                 relations[l] = Relation::Umbra;
-                if p.occluder != crate::edges::BEHIND_LIGHT {
+                if p.occluder != crate::shadows::BEHIND_LIGHT {
                     blockers[l] = vec![p.occluder];
                 } else {
                     blockers[l].clear();
@@ -234,7 +238,7 @@ pub fn build_regions(
         }
     };
     let n_lights = sh.exposure.len();
-    let mut parent: Vec<u32> = (0..arr.faces.len() as u32).collect();
+    let mut merged = UnionFind::new(arr.faces.len());
     let mut kept = Vec::new();
     let mut n_disc = 0u64;
     for (ei, e) in arr.edges.iter().enumerate() {
@@ -258,15 +262,13 @@ pub fn build_regions(
                 }
             });
         if redundant {
-            union(&mut parent, a, b);
+            merged.union(a, b);
         } else if a != b {
             kept.push(ei as u32);
             n_disc += 1;
         }
     }
-    let n_regions = (0..parent.len() as u32)
-        .filter(|&i| find(&mut parent, i) == i)
-        .count() as u64;
+    let n_regions = merged.count_sets() as u64;
     let t_div = t3.elapsed().as_secs_f64();
     (
         ReceiverRegions {
@@ -308,7 +310,7 @@ fn uniform_regions(r: &Face, sh: &ReceiverShadows, diag: f64) -> ReceiverRegions
             continue;
         }
         rf.relations[l] = Relation::Penumbra;
-        if p.occluder != crate::edges::BEHIND_LIGHT {
+        if p.occluder != crate::shadows::BEHIND_LIGHT {
             rf.blockers[l].push(p.occluder);
         }
     }
@@ -340,19 +342,4 @@ fn on_boundary(poly: &[DVec2], a: DVec2, b: DVec2, tol: f64) -> bool {
             && (d.perp_dot(a - p) / len).abs() <= tol
             && (d.perp_dot(b - p) / len).abs() <= tol
     })
-}
-
-fn find(p: &mut [u32], mut i: u32) -> u32 {
-    while p[i as usize] != i {
-        p[i as usize] = p[p[i as usize] as usize];
-        i = p[i as usize];
-    }
-    i
-}
-
-fn union(p: &mut [u32], a: u32, b: u32) {
-    let (ra, rb) = (find(p, a), find(p, b));
-    if ra != rb {
-        p[ra.max(rb) as usize] = ra.min(rb);
-    }
 }

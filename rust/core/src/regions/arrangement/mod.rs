@@ -137,7 +137,7 @@ impl Arrangement {
 ///
 /// ```
 /// use glam::DVec2;
-/// use penumbra::arrangement::{build, Segment};
+/// use penumbra::regions::arrangement::{build, Segment};
 /// let square = [DVec2::new(0., 0.), DVec2::new(1., 0.), DVec2::new(1., 1.), DVec2::new(0., 1.)];
 /// let chord = Segment { a: DVec2::new(0.5, 0.), b: DVec2::new(0.5, 1.), tag: 7 };
 /// let arr = build(&square, &[chord], 1e-9);

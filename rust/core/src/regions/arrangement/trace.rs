@@ -10,6 +10,7 @@ use glam::DVec2;
 
 use super::{interior, winding, ArrEdge, ArrFace};
 use crate::geom::polygon::orient;
+use crate::geom::union_find::UnionFind;
 
 /// Half-edge `h` runs along edge `h / 2`, from `v[0]` to `v[1]` when `h` is even.
 #[inline]
@@ -316,20 +317,9 @@ fn bbox(pts: &[DVec2], edges: &[ArrEdge], hs: &[u32]) -> (DVec2, DVec2) {
 
 /// Connected component of every vertex (union–find).
 fn components(n: usize, edges: &[ArrEdge]) -> Vec<u32> {
-    let mut parent: Vec<u32> = (0..n as u32).collect();
-    fn find(parent: &mut [u32], mut x: u32) -> u32 {
-        while parent[x as usize] != x {
-            let g = parent[parent[x as usize] as usize];
-            parent[x as usize] = g;
-            x = g;
-        }
-        x
-    }
+    let mut sets = UnionFind::new(n);
     for e in edges {
-        let (a, b) = (find(&mut parent, e.v[0]), find(&mut parent, e.v[1]));
-        if a != b {
-            parent[a.max(b) as usize] = a.min(b);
-        }
+        sets.union(e.v[0], e.v[1]);
     }
-    (0..n as u32).map(|v| find(&mut parent, v)).collect()
+    (0..n as u32).map(|v| sets.find(v)).collect()
 }

@@ -4,7 +4,7 @@
 use glam::DVec2;
 
 use super::{check, point_segment_distance, pts, rect, rect_segments, v};
-use crate::arrangement::{build, Arrangement, Segment};
+use crate::regions::arrangement::{build, Arrangement, Segment};
 
 /// splitmix64: a tiny deterministic generator, good enough for test inputs.
 struct Rng(u64);

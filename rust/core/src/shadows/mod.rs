@@ -3,97 +3,28 @@
 //! intersection is a convex polygon in the receiver's 2-D frame, whose edges are the
 //! discontinuity edges.
 
+pub mod buried;
+pub mod critical_lines;
+pub mod culling;
+pub mod plane_cuts;
+pub mod polygons;
+pub mod umbra_pruning;
+pub mod volume;
+
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
-use crate::cuts::{inside_solid, plane_cut};
-use crate::events::critical_segments;
 use crate::geom::bvh::{Aabb, BoxTree};
-use crate::geom::polygon::{
-    clip_polygon_2d, clip_polygon_3d, inside_convex, signed_area_2d, simplify_convex, HalfPlane,
-};
-use crate::geom::{Frame, Plane};
+use crate::geom::polygon::{clip_polygon_3d, inside_convex, signed_area_2d};
 use crate::scene::solids::Occluder;
 use crate::scene::{Face, LightKind, Scene};
-use crate::screens::{screen_faces, screened};
-use crate::shadow::{shadow_volumes, solid_volumes, ShadowVolumes, SolidShadow, Volume};
-
-/// `occluder` value of the polygon that marks the part of a receiver behind an area light's
-/// plane (the light emits nothing there).
-pub const BEHIND_LIGHT: u32 = u32::MAX;
-
-/// A shadow volume cut down to one receiver.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ShadowPolygon {
-    pub light: u32,
-    pub occluder: u32,
-    pub umbra: bool,
-    /// From a point or sun light: its boundary is a D0 discontinuity.
-    pub hard: bool,
-    /// Convex, counter-clockwise, in the receiver's frame.
-    pub poly: Vec<DVec2>,
-}
-
-/// How one light stands to one receiver as a whole.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Exposure {
-    /// The light cannot reach the receiver's front anywhere.
-    Hidden,
-    /// Regions decide (shadow polygons).
-    Regions,
-}
-
-/// Everything the later stages need about the shadows on one receiver.
-#[derive(Debug, Clone)]
-pub struct ReceiverShadows {
-    pub face: u32,
-    pub exposure: Vec<Exposure>,
-    pub polys: Vec<ShadowPolygon>,
-    /// Occluder edges lying on the receiver (contact lines), in its frame: light jumps
-    /// across them (D0), so the mesh must not share vertices there.
-    pub contacts: Vec<[DVec2; 2]>,
-    /// Lines where an occluder face passes through the receiver (`cuts::plane_cut`), in its
-    /// frame: D0 like contacts, and the arrangement must split along them.
-    pub plane_cuts: Vec<[DVec2; 2]>,
-    /// The parts of the receiver inside closed solids (convex, counter-clockwise, in its
-    /// frame): no light reaches them.
-    pub inside: Vec<Vec<DVec2>>,
-    /// VE/EV critical lines inside penumbrae (light index, segment), see `events`.
-    pub events: Vec<(u32, [DVec2; 2])>,
-}
-
-/// Restricts a 3-D half-space to the receiver's plane: a 2-D half-plane in its frame, or
-/// all (`Ok(None)`) / nothing (`Err(())`) when the planes are parallel.
-fn restrict(h: &Plane, f: &Frame, eps: f64) -> Result<Option<HalfPlane>, ()> {
-    let n = DVec2::new(h.n.dot(f.u), h.n.dot(f.v));
-    let c = h.d - h.n.dot(f.origin);
-    if n.length() <= 1e-14 {
-        return if -c >= -eps { Ok(None) } else { Err(()) };
-    }
-    Ok(Some(HalfPlane { n, c }))
-}
-
-/// The part of receiver `r` inside `vol`, or `None` if it has no area.
-pub fn clip_to_volume(r: &Face, vol: &Volume, eps: f64) -> Option<Vec<DVec2>> {
-    let mut poly = r.poly2.clone();
-    for h in &vol.planes {
-        match restrict(h, &r.frame, eps) {
-            Err(()) => return None,
-            Ok(None) => {}
-            Ok(Some(hp)) => {
-                poly = clip_polygon_2d(&poly, &hp, eps);
-                if poly.len() < 3 {
-                    return None;
-                }
-            }
-        }
-    }
-    let poly = simplify_convex(&poly);
-    if poly.len() < 3 || signed_area_2d(&poly) <= eps * eps {
-        return None;
-    }
-    Some(poly)
-}
+use crate::shadows::critical_lines::critical_segments;
+use crate::shadows::culling::{screen_faces, screened};
+use crate::shadows::plane_cuts::{inside_solid, plane_cut};
+use crate::shadows::volume::{
+    clip_to_volume, shadow_volumes, solid_volumes, ShadowVolumes, SolidShadow, Volume,
+};
+pub use polygons::{Exposure, ReceiverShadows, ShadowPolygon, BEHIND_LIGHT};
 
 /// The light as the receiver's front half-space sees it: `None` when it is wholly behind.
 fn light_in_front(kind: &LightKind, r: &Face, eps: f64) -> Option<Option<Vec<DVec3>>> {
@@ -180,7 +111,7 @@ pub fn shadow_polygons(
     let tree = BoxTree::new(faces.iter().map(|f| Aabb::from_points(&f.verts)).collect());
     let outlines: Vec<(Vec<DVec3>, Vec<[DVec3; 2]>)> =
         occs.iter().map(|o| occluder_outline(o, faces)).collect();
-    let buried = crate::buried::burial(scene, eps);
+    let buried = crate::shadows::buried::burial(scene, eps);
     let mut stats = EdgeStats::default();
     let mut per_receiver: Vec<ReceiverShadows> = (0..faces.len())
         .map(|i| ReceiverShadows {
@@ -298,9 +229,9 @@ pub fn shadow_polygons(
     }
     let t2 = std::time::Instant::now();
     per_receiver.par_iter_mut().zip(faces).for_each(|(r, f)| {
-        crate::umbra_cover::drop_covered(&mut r.polys, &r.inside);
+        crate::shadows::umbra_pruning::drop_covered(&mut r.polys, &r.inside);
         let snap = 1e-9 * f.extent(scene.diagonal());
-        crate::umbra_cover::trim_lines(r, snap, !scene.settings.indirect);
+        crate::shadows::umbra_pruning::trim_lines(r, snap, !scene.settings.indirect);
     });
     stats.t_isr += t2.elapsed().as_secs_f64();
     Ok((per_receiver, stats))

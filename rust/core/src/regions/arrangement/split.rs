@@ -11,6 +11,7 @@ use glam::DVec2;
 
 use super::snap::VertexPool;
 use crate::geom::polygon::orient;
+use crate::geom::union_find::UnionFind;
 
 /// Snapping a crossing point moves an edge by up to `snap`, which can make it meet an edge
 /// it did not meet before; each round fixes those. Ordinary inputs settle in one or two
@@ -40,7 +41,9 @@ impl Edge {
 /// Splits and merges until no pair of edges crosses, touches in an interior point or overlaps.
 pub(super) fn split_all(pool: &mut VertexPool, edges: Vec<Edge>, snap: f64) -> Vec<Edge> {
     let mut edges = merge(edges);
-    let mut alias = Alias::default();
+    // Vertices merged into others; the older vertex represents the set, so the receiver
+    // corners, inserted first, never move.
+    let mut alias = UnionFind::default();
     for _ in 0..MAX_ROUNDS {
         let pairs = candidate_pairs(pool.points(), &edges, snap);
         let mut found = Found {
@@ -67,7 +70,7 @@ pub(super) fn split_all(pool: &mut VertexPool, edges: Vec<Edge>, snap: f64) -> V
                 edges
                     .into_iter()
                     .map(|e| Edge {
-                        v: e.v.map(|v| alias.find(v)),
+                        v: e.v.map(|v| alias.root(v)),
                         tags: e.tags,
                     })
                     .collect(),
@@ -88,34 +91,6 @@ struct Found {
     splits: Vec<Vec<u32>>,
     /// Vertex pairs to be made one.
     merges: Vec<(u32, u32)>,
-}
-
-/// Vertices merged into others (union–find; the older vertex represents the set, so the
-/// receiver corners, inserted first, never move).
-#[derive(Default)]
-struct Alias {
-    parent: Vec<u32>,
-}
-
-impl Alias {
-    fn find(&self, mut v: u32) -> u32 {
-        while let Some(&p) = self.parent.get(v as usize) {
-            if p == v {
-                break;
-            }
-            v = p;
-        }
-        v
-    }
-
-    fn union(&mut self, a: u32, b: u32) {
-        let (a, b) = (self.find(a), self.find(b));
-        let n = a.max(b) as usize + 1;
-        if self.parent.len() < n {
-            self.parent.extend(self.parent.len() as u32..n as u32);
-        }
-        self.parent[a.max(b) as usize] = a.min(b);
-    }
 }
 
 /// One edge per vertex pair, carrying the tags of everything that landed on it.
@@ -213,7 +188,7 @@ pub(super) fn candidate_pairs(pts: &[DVec2], edges: &[Edge], snap: f64) -> Vec<(
 /// meet only at end vertices.
 fn intersect_pair(
     pool: &mut VertexPool,
-    alias: &Alias,
+    alias: &UnionFind,
     edges: &[Edge],
     (i, j): (usize, usize),
     snap: f64,
@@ -263,7 +238,7 @@ fn intersect_pair(
     // o3, o4 are twice the signed areas of c-d-a and c-d-b, so they weigh the split of a→b.
     let t = (o3 / (o3 - o4)).clamp(0.0, 1.0);
     let x = pa + (pb - pa) * t;
-    let v = alias.find(pool.insert(x));
+    let v = alias.root(pool.insert(x));
     if v != a && v != b {
         found.splits[i].push(v);
     }

@@ -4,7 +4,7 @@
 
 use glam::DVec3;
 
-use crate::relation::Relation;
+use crate::regions::relation::Relation;
 
 #[derive(Debug, Clone, Default)]
 pub struct Elements {

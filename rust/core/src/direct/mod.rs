@@ -4,14 +4,15 @@
 //! integral; otherwise the exact visible part of the light, with only the occluders whose
 //! penumbra contains one of those triangles as candidates.
 
+pub mod exact;
+
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::direct;
-use crate::elements::Elements;
 use crate::geom::polygon::convex_hull_2d;
 use crate::geom::{Frame, Plane};
-use crate::relation::Relation;
+use crate::mesh::elements::Elements;
+use crate::regions::relation::Relation;
 use crate::scene::solids::{Occluder, Solid};
 use crate::scene::{LightKind, Scene};
 
@@ -138,7 +139,7 @@ fn vertex_direct(scene: &Scene, el: &Elements, v: usize, regions: &[u32]) -> (DV
                 verts,
                 plane,
                 radiance,
-            } => direct::area_light(
+            } => exact::area_light(
                 p,
                 n,
                 verts,
@@ -161,13 +162,13 @@ fn vertex_direct(scene: &Scene, el: &Elements, v: usize, regions: &[u32]) -> (DV
                 } else {
                     1.0
                 };
-                direct::point_light(p, n, *position, *intensity, spot.as_ref(), relation, &polys)
+                exact::point_light(p, n, *position, *intensity, spot.as_ref(), relation, &polys)
                     * soft
             }
             LightKind::Sun {
                 direction,
                 irradiance,
-            } => direct::sun_light(p, n, *direction, *irradiance, relation, &polys),
+            } => exact::sun_light(p, n, *direction, *irradiance, relation, &polys),
         };
     }
     (e, counts)

@@ -4,6 +4,9 @@
 //! lights (`sizing`), then Delaunay refinement fixes angles. Edges across which some light jumps from lit to umbra (D0:
 //! contact shadows, point-light shadows) get two vertex rows, one per side.
 
+pub mod elements;
+pub mod sizing;
+
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -15,13 +18,13 @@ use spade::{
     AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation,
 };
 
-use crate::arrangement::ArrFace;
-use crate::edges::ReceiverShadows;
 use crate::geom::polygon::{orient, segment_distance as seg_dist};
+use crate::mesh::sizing::Sizing;
+use crate::regions::arrangement::ArrFace;
+use crate::regions::relation::Relation;
 use crate::regions::{Indexed, ReceiverRegions, RegionFace};
-use crate::relation::Relation;
-use crate::settings::Settings;
-use crate::sizing::Sizing;
+use crate::scene::settings::Settings;
+use crate::shadows::ReceiverShadows;
 use crate::BakeError;
 
 /// The element mesh of one receiver, in its 2-D frame.

@@ -12,12 +12,14 @@
 //! A light that straddles O's plane is cut by it into two pieces, each with its own S on the
 //! far side of O; such a light has no umbra behind O alone.
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use robust::{orient3d, Coord3D};
 
 use crate::geom::plane::newell_normal;
-use crate::geom::polygon::clip_polygon_3d;
-use crate::geom::Plane;
+use crate::geom::polygon::{
+    clip_polygon_2d, clip_polygon_3d, signed_area_2d, simplify_convex, HalfPlane,
+};
+use crate::geom::{Frame, Plane};
 use crate::scene::solids::Solid;
 use crate::scene::{Face, LightKind};
 
@@ -517,6 +519,39 @@ fn point_solid_volume(l: DVec3, s: &Solid, eps: f64) -> Option<Volume> {
         }
     }
     Some(Volume { planes, cap: 0 })
+}
+
+/// Restricts a 3-D half-space to the receiver's plane: a 2-D half-plane in its frame, or
+/// all (`Ok(None)`) / nothing (`Err(())`) when the planes are parallel.
+fn restrict(h: &Plane, f: &Frame, eps: f64) -> Result<Option<HalfPlane>, ()> {
+    let n = DVec2::new(h.n.dot(f.u), h.n.dot(f.v));
+    let c = h.d - h.n.dot(f.origin);
+    if n.length() <= 1e-14 {
+        return if -c >= -eps { Ok(None) } else { Err(()) };
+    }
+    Ok(Some(HalfPlane { n, c }))
+}
+
+/// The part of receiver `r` inside `vol`, or `None` if it has no area.
+pub fn clip_to_volume(r: &Face, vol: &Volume, eps: f64) -> Option<Vec<DVec2>> {
+    let mut poly = r.poly2.clone();
+    for h in &vol.planes {
+        match restrict(h, &r.frame, eps) {
+            Err(()) => return None,
+            Ok(None) => {}
+            Ok(Some(hp)) => {
+                poly = clip_polygon_2d(&poly, &hp, eps);
+                if poly.len() < 3 {
+                    return None;
+                }
+            }
+        }
+    }
+    let poly = simplify_convex(&poly);
+    if poly.len() < 3 || signed_area_2d(&poly) <= eps * eps {
+        return None;
+    }
+    Some(poly)
 }
 
 #[cfg(test)]
