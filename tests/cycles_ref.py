@@ -21,8 +21,12 @@ import sys
 import numpy as np
 
 ADDON_DIR = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "addon")
-if ADDON_DIR not in sys.path:
-    sys.path.insert(0, ADDON_DIR)
+SCRIPTS_DIR = os.path.join(os.path.dirname(ADDON_DIR), "scripts")
+for _d in (SCRIPTS_DIR, ADDON_DIR):
+    if _d not in sys.path:
+        sys.path.insert(0, _d)
+
+import cycles_setup  # noqa: E402
 
 
 # --------------------------------------------------------------------------------------------
@@ -35,38 +39,12 @@ def new_scene(samples: int = 1024, seed: int = 0):
     No world (Cycles then has no background light), adaptive sampling off, no clamping,
     light tree on (the default; it is unbiased), CPU device.
     """
-    import bpy
-
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    scene = bpy.context.scene
-    scene.render.engine = "CYCLES"
-    cy = scene.cycles
-    cy.device = "CPU"
-    cy.samples = samples
-    cy.seed = seed
-    cy.use_adaptive_sampling = False
-    cy.use_denoising = False
-    cy.sample_clamp_direct = 0.0
-    cy.sample_clamp_indirect = 0.0
-    scene.world = None
-    scene.render.threads_mode = "FIXED"
-    scene.render.threads = max(1, min(2, os.cpu_count() or 1))
-    return scene
+    return cycles_setup.reset_scene(samples, seed)
 
 
 def diffuse_material(name: str = "White", color=(1.0, 1.0, 1.0)):
     """A Lambertian material: a Diffuse BSDF (roughness 0) with the given linear colour."""
-    import bpy
-
-    mat = bpy.data.materials.new(name)
-    nt = mat.node_tree
-    nt.nodes.clear()
-    out = nt.nodes.new("ShaderNodeOutputMaterial")
-    bsdf = nt.nodes.new("ShaderNodeBsdfDiffuse")
-    bsdf.inputs["Color"].default_value = (*color, 1.0)
-    bsdf.inputs["Roughness"].default_value = 0.0
-    nt.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
-    return mat
+    return cycles_setup.lambert_material(name, color)
 
 
 def add_grid(n: int = 32, size: float = 4.0, location=(0.0, 0.0, 0.0), material=None,

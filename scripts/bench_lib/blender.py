@@ -11,54 +11,14 @@
 from __future__ import annotations
 
 import math
-import os
 
 import numpy as np
 
+import cycles_setup
+
 
 def reset(samples: int, seed: int, adaptive: bool, bounces: int, threads: int):
-    import bpy
-
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    sc = bpy.context.scene
-    sc.render.engine = "CYCLES"
-    cy = sc.cycles
-    cy.device = "CPU"
-    cy.samples = samples
-    cy.seed = seed
-    cy.use_adaptive_sampling = adaptive
-    cy.use_denoising = False
-    cy.sample_clamp_direct = 0.0
-    cy.sample_clamp_indirect = 0.0
-    cy.max_bounces = bounces
-    cy.diffuse_bounces = bounces
-    sc.world = None
-    sc.render.threads_mode = "FIXED"
-    sc.render.threads = threads
-    return sc
-
-
-def _material(name, albedo, emission):
-    import bpy
-
-    mat = bpy.data.materials.new(name)
-    nt = mat.node_tree
-    nt.nodes.clear()
-    out = nt.nodes.new("ShaderNodeOutputMaterial")
-    bsdf = nt.nodes.new("ShaderNodeBsdfDiffuse")
-    bsdf.inputs["Color"].default_value = (*albedo, 1.0)
-    bsdf.inputs["Roughness"].default_value = 0.0
-    shader = bsdf.outputs["BSDF"]
-    if emission is not None and max(emission) > 0:
-        em = nt.nodes.new("ShaderNodeEmission")
-        em.inputs["Color"].default_value = (*emission, 1.0)
-        em.inputs["Strength"].default_value = 1.0
-        add = nt.nodes.new("ShaderNodeAddShader")
-        nt.links.new(shader, add.inputs[0])
-        nt.links.new(em.outputs["Emission"], add.inputs[1])
-        shader = add.outputs["Shader"]
-    nt.links.new(shader, out.inputs["Surface"])
-    return mat
+    return cycles_setup.reset_scene(samples, seed, adaptive, bounces, threads)
 
 
 def _per_polygon(v, n):
@@ -154,7 +114,7 @@ def cycles_scene(scene: dict, lattices: list[dict]):
             k = (a, e)
             if k not in keys:
                 keys[k] = len(mats)
-                mats.append(_material(f"{m['name']}.{len(mats)}", a, e))
+                mats.append(cycles_setup.lambert_material(f"{m['name']}.{len(mats)}", a, e))
             pmat.append(keys[k])
         tri_poly = lat["polygon"][lat["tris"][:, 0]]
         objs.append(_object(m["name"], lat["verts"], lat["tris"],

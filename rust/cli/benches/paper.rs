@@ -6,8 +6,8 @@
 
 use std::time::Instant;
 
+use penumbra::scenes;
 use penumbra::{Progress, Stats};
-use penumbra_cli::scenes;
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);

@@ -1,5 +1,4 @@
-//! Built-in scenes (the paper's test data and benchmark scenes) for the `penumbra scene`
-//! command and the benchmarks.
+//! The `penumbra` command's pieces that are not the core: glTF output. The built-in scenes
+//! live in the core (`penumbra::scenes`), shared with its tests.
 
 pub mod gltf;
-pub mod scenes;

@@ -89,12 +89,12 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> ExitCode {
     match cli.command {
         Command::Scene { name, output } => {
-            let Some(s) = penumbra_cli::scenes::by_name(&name) else {
+            let Some(s) = penumbra::scenes::by_name(&name) else {
                 return fail(
                     2,
                     format!(
                         "unknown scene {name:?} (one of {})",
-                        penumbra_cli::scenes::NAMES.join(", ")
+                        penumbra::scenes::NAMES.join(", ")
                     ),
                 );
             };

@@ -123,7 +123,10 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
     };
 
     progress.stage("shadow volumes");
-    let (shadows, es) = shadows::shadow_polygons(scene, progress)?;
+    // Contact lines and plane cuts stay discontinuities even in umbra on both sides when
+    // indirect light follows: bounced light reaches the floor beside a box, never under it.
+    let keep_contacts = scene.settings.indirect;
+    let (shadows, es) = shadows::shadow_polygons(scene, keep_contacts, progress)?;
     stats.T_sdw = es.t_sdw;
     stats.T_isr = es.t_isr;
     stats.shadow_pairs = es.shadow_pairs;
@@ -136,10 +139,8 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
     let built: Vec<(ReceiverRegions, RegionTimes)> = scene
         .faces
         .par_iter()
-        .zip(&shadows)
-        .map(|(f, sh)| {
-            regions::build_regions(f, sh, diag, scene.settings.uniform, scene.settings.indirect)
-        })
+        .zip(shadows)
+        .map(|(f, sh)| regions::build_regions(f, sh, diag, scene.settings.uniform, keep_contacts))
         .collect();
     // Stage times are wall time, split between sub-stages by their share of CPU time.
     let wall = t.elapsed().as_secs_f64();
@@ -166,12 +167,11 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
     let budget = AtomicU64::new(0);
     let meshes: Vec<ReceiverMesh> = regions
         .par_iter()
-        .zip(&shadows)
         .zip(&scene.faces)
-        .map(|((rr, sh), f)| {
+        .map(|(rr, f)| {
             progress.check()?;
             let sizing = Sizing::new(f, &scene.lights, &scene.settings);
-            mesh::mesh_receiver(rr, sh, &sizing, &scene.settings, diag, &budget)
+            mesh::mesh_receiver(rr, &sizing, &scene.settings, diag, &budget)
         })
         .collect::<Result<_, _>>()?;
     let elements = assemble(scene, &meshes);

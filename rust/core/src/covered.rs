@@ -133,7 +133,7 @@ fn perimeter(p: &[DVec2]) -> f64 {
 #[cfg(test)]
 mod test {
     use super::*;
-    use crate::geom::raycast::test::face;
+    use crate::scene::test::face;
     use glam::DVec3;
 
     #[test]

@@ -4,20 +4,25 @@
 //! The pipeline runs one direction: `scene` → `shadow` → `edges` → `arrangement`/`relation`
 //! → `mesh` → `direct` → `indirect` → `bake` (output).
 
+// The pipeline, in order (see ARCHITECTURE.md). Public: what the CLI, the binding and the
+// tests use (the input format, the bake and its output, the built-in scenes, the exact direct
+// light and the geometry it rests on); the stages' engines are the crate's own.
 pub mod bake;
 pub mod direct;
-pub mod error;
-pub mod geom;
-pub mod indirect;
-pub mod mesh;
-pub mod progress;
+pub(crate) mod indirect;
+pub(crate) mod mesh;
 pub mod regions;
 pub mod scene;
-pub mod shadows;
+pub(crate) mod shadows;
+
+pub mod error;
+pub mod geom;
+pub mod progress;
+pub mod scenes;
 
 // Moved into `indirect/` by the hierarchical-radiosity work.
-pub mod covered;
-pub mod patches;
+pub(crate) mod covered;
+pub(crate) mod patches;
 
 pub use bake::{bake, bake_scene_json, Bake, BakedMesh, Stats};
 pub use error::BakeError;

@@ -424,7 +424,7 @@ fn unit(h: u64) -> f64 {
 #[cfg(test)]
 pub(crate) mod test {
     use super::*;
-    use crate::geom::raycast::test::face;
+    use crate::scene::test::face;
 
     /// Elements for `faces` by hand: each face's fan triangles split `k` times per side (so
     /// vertices on a face are not shared with other faces, as the mesher leaves them).

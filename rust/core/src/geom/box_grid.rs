@@ -4,6 +4,7 @@
 
 use glam::DVec2;
 
+#[derive(Debug, Clone)]
 pub struct BoxGrid {
     lo: DVec2,
     inv: DVec2,

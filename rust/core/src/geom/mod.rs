@@ -13,3 +13,11 @@ pub mod union_find;
 
 pub use frame::Frame;
 pub use plane::Plane;
+
+use glam::DVec3;
+
+/// A convex planar polygon in 3-D, as the visibility index (`raycast`) takes it.
+pub trait PlanarPolygon {
+    fn verts(&self) -> &[DVec3];
+    fn plane(&self) -> Plane;
+}

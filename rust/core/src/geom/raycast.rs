@@ -26,8 +26,7 @@ use obvhs::bvh2::Bvh2;
 use obvhs::ray::Ray;
 use obvhs::BvhBuildParams;
 
-use crate::geom::Plane;
-use crate::scene::Face;
+use crate::geom::{PlanarPolygon, Plane};
 
 /// One face as the ray tests need it.
 #[derive(Debug, Clone)]
@@ -58,10 +57,10 @@ pub struct Occluders {
 impl Occluders {
     /// Indexes `faces` (face ids in queries are indices into this slice). Faces with fewer
     /// than 3 vertices or no normal are kept as ids but never block.
-    pub fn new(faces: &[Face]) -> Self {
+    pub fn new<F: PlanarPolygon>(faces: &[F]) -> Self {
         let mut lo = DVec3::splat(f64::INFINITY);
         let mut hi = DVec3::splat(f64::NEG_INFINITY);
-        for v in faces.iter().flat_map(|f| f.verts.iter()) {
+        for v in faces.iter().flat_map(|f| f.verts().iter()) {
             lo = lo.min(*v);
             hi = hi.max(*v);
         }
@@ -335,25 +334,26 @@ impl Occluder {
     }
 }
 
-fn occluder(f: &Face, tol: f64) -> Occluder {
+fn occluder(f: &impl PlanarPolygon, tol: f64) -> Occluder {
+    let (verts, plane) = (f.verts(), f.plane());
     let mut lo = DVec3::splat(f64::INFINITY);
     let mut hi = DVec3::splat(f64::NEG_INFINITY);
-    for v in &f.verts {
+    for v in verts {
         lo = lo.min(*v);
         hi = hi.max(*v);
     }
-    let n = f.plane.n;
-    let mut edges = Vec::with_capacity(f.verts.len());
-    let k = f.verts.len();
+    let n = plane.n;
+    let mut edges = Vec::with_capacity(verts.len());
+    let k = verts.len();
     if k >= 3 && n.is_finite() && n.length_squared() > 0.5 {
         for i in 0..k {
-            let e = f.verts[(i + 1) % k] - f.verts[i];
+            let e = verts[(i + 1) % k] - verts[i];
             let m = n.cross(e);
             let l = m.length();
             // Repeated vertices give zero-length edges, which bound nothing.
             if l > tol {
                 let m = m / l;
-                edges.push((m, m.dot(f.verts[i])));
+                edges.push((m, m.dot(verts[i])));
             }
         }
         if edges.len() < 3 {
@@ -361,8 +361,8 @@ fn occluder(f: &Face, tol: f64) -> Occluder {
         }
     }
     Occluder {
-        plane: f.plane,
-        verts: f.verts.clone(),
+        plane,
+        verts: verts.to_vec(),
         edges,
         lo,
         hi,
@@ -377,33 +377,32 @@ fn to_f32(v: DVec3) -> Vec3A {
 #[cfg(test)]
 pub(crate) mod test {
     use super::*;
-    use crate::geom::polygon::signed_area_2d;
-    use crate::geom::Frame;
 
-    /// A face from counter-clockwise (seen from the front) vertices.
-    pub(crate) fn face(verts: &[DVec3], albedo: DVec3, emission: DVec3) -> Face {
-        let plane = Plane::from_polygon(verts).expect("face has area");
-        let verts: Vec<DVec3> = verts
-            .iter()
-            .map(|v| *v - plane.n * plane.dist(*v))
-            .collect();
-        let frame = Frame::on_plane(&plane, verts[0]);
-        let poly2: Vec<_> = verts.iter().map(|v| frame.to_2d(*v)).collect();
-        let area = signed_area_2d(&poly2);
-        Face {
-            mesh: 0,
-            source_polygon: 0,
-            verts,
-            plane,
-            frame,
-            poly2,
-            albedo,
-            emission,
-            area,
+    /// A convex polygon from counter-clockwise (seen from the front) vertices.
+    struct Poly {
+        verts: Vec<DVec3>,
+        plane: Plane,
+    }
+
+    impl PlanarPolygon for Poly {
+        fn verts(&self) -> &[DVec3] {
+            &self.verts
+        }
+        fn plane(&self) -> Plane {
+            self.plane
         }
     }
 
-    fn quad(c: DVec3, u: DVec3, v: DVec3) -> Face {
+    fn face(verts: &[DVec3], _albedo: DVec3, _emission: DVec3) -> Poly {
+        let plane = Plane::from_polygon(verts).expect("face has area");
+        let verts = verts
+            .iter()
+            .map(|v| *v - plane.n * plane.dist(*v))
+            .collect();
+        Poly { verts, plane }
+    }
+
+    fn quad(c: DVec3, u: DVec3, v: DVec3) -> Poly {
         face(
             &[c - u - v, c + u - v, c + u + v, c - u + v],
             DVec3::splat(0.5),
@@ -567,7 +566,7 @@ pub(crate) mod test {
 
     #[test]
     fn empty_scene_blocks_nothing() {
-        let o = Occluders::new(&[]);
+        let o = Occluders::new::<Poly>(&[]);
         assert!(!o.segment_blocked(DVec3::ZERO, DVec3::ONE));
         assert!(!o.ray_blocked(DVec3::ZERO, DVec3::ONE));
     }

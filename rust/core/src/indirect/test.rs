@@ -1,11 +1,11 @@
 //! Tests of the indirect stage against closed forms and the white furnace.
 
 use super::*;
-use crate::geom::raycast::test::face;
 use crate::geom::Plane;
 use crate::patches::test::grid_elements;
 use crate::scene::json::SettingsJson;
 use crate::scene::settings::Settings;
+use crate::scene::test::face;
 use crate::scene::Face;
 
 fn v(x: f64, y: f64, z: f64) -> DVec3 {

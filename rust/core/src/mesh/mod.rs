@@ -22,9 +22,8 @@ use crate::geom::polygon::{orient, segment_distance as seg_dist};
 use crate::mesh::sizing::Sizing;
 use crate::regions::arrangement::ArrFace;
 use crate::regions::relation::Relation;
-use crate::regions::{Indexed, ReceiverRegions, RegionFace};
+use crate::regions::{ReceiverRegions, RegionFace};
 use crate::scene::settings::Settings;
-use crate::shadows::ReceiverShadows;
 use crate::BakeError;
 
 /// The element mesh of one receiver, in its 2-D frame.
@@ -47,7 +46,6 @@ type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
 /// side tests of the light stages see them on their own side.
 pub fn mesh_receiver(
     rr: &ReceiverRegions,
-    sh: &ReceiverShadows,
     sizing: &Sizing,
     settings: &Settings,
     diag: f64,
@@ -78,7 +76,7 @@ pub fn mesh_receiver(
     // Seed nodes: a lattice per face, spaced by the face's relation and the distance to the
     // lights.
     let coarse = settings.element_size;
-    let corners = Corners::new(sh, coarse);
+    let corners = Corners::new(&rr.d0_lines, coarse);
     let mut seeds = Vec::new();
     for (f, rf) in arr.faces.iter().zip(&rr.faces) {
         let penumbra = !settings.uniform && rf.relations.iter().any(|r| *r == Relation::Penumbra);
@@ -127,14 +125,14 @@ pub fn mesh_receiver(
         Ordering::Relaxed,
     );
     if settings.uniform {
-        let mut m = extract(&cdt, sh, sizing.frame(), true, diag);
+        let mut m = extract(&cdt, rr, sizing.frame(), true, diag);
         m.regions = vec![rr.faces.first().cloned().unwrap_or(RegionFace {
             relations: Vec::new(),
             blockers: Vec::new(),
         })];
         return Ok(m);
     }
-    Ok(extract(&cdt, sh, sizing.frame(), false, diag))
+    Ok(extract(&cdt, rr, sizing.frame(), false, diag))
 }
 
 /// Ends of D0 lines (the feet of a box on the floor, where a solid passes through): there
@@ -154,13 +152,8 @@ const PER_CORNER_DISTANCE: f64 = 0.7;
 const CORNER_FLOOR: f64 = 1.0 / 16.0;
 
 impl Corners {
-    fn new(sh: &ReceiverShadows, coarse: f64) -> Self {
-        let mut points: Vec<DVec2> = sh
-            .contacts
-            .iter()
-            .chain(&sh.plane_cuts)
-            .flat_map(|[a, b]| [*a, *b])
-            .collect();
+    fn new(d0_lines: &[[DVec2; 2]], coarse: f64) -> Self {
+        let mut points: Vec<DVec2> = d0_lines.iter().flat_map(|[a, b]| [*a, *b]).collect();
         points.sort_unstable_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
         points.dedup();
         Corners {
@@ -313,7 +306,7 @@ fn winding(verts: &[DVec2], l: &[u32], p: DVec2) -> i32 {
 /// once each), and the D0 vertex split.
 fn extract(
     cdt: &Cdt,
-    sh: &ReceiverShadows,
+    rr: &ReceiverRegions,
     frame: &Frame,
     uniform: bool,
     diag: f64,
@@ -348,7 +341,6 @@ fn extract(
     }
     let mut comp = vec![u32::MAX; faces.len()];
     let mut regions: Vec<RegionFace> = Vec::new();
-    let index = Indexed::new(&sh.polys, &sh.inside);
     for start in 0..faces.len() {
         if comp[start] != u32::MAX {
             continue;
@@ -376,7 +368,7 @@ fn extract(
             }
         }
         let c = faces[best.1].center();
-        regions.push(index.classify(DVec2::new(c.x, c.y), &sh.exposure));
+        regions.push(rr.classify(DVec2::new(c.x, c.y)));
     }
 
     // D0 split: group the triangles around each vertex into sectors that do not cross a
@@ -396,9 +388,8 @@ fn extract(
     // Contacts and plane cuts: an occluder meets the receiver there, so light jumps even
     // where both sides are in penumbra.
     let on_contact = |p: DVec2, q: DVec2| {
-        sh.contacts
+        rr.d0_lines
             .iter()
-            .chain(&sh.plane_cuts)
             .any(|&[a, b]| seg_dist(a, b, p) <= 1e-9 * scale && seg_dist(a, b, q) <= 1e-9 * scale)
     };
     let is_d0_edge = |e: spade::handles::DirectedEdgeHandle<

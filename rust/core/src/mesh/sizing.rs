@@ -124,9 +124,9 @@ impl Sizing {
 #[cfg(test)]
 mod test {
     use super::*;
-    use crate::geom::raycast::test::face;
     use crate::geom::Plane;
     use crate::scene::json::SettingsJson;
+    use crate::scene::test::face;
 
     #[test]
     fn sizes_follow_the_distance_to_the_light_within_their_bounds() {

@@ -38,31 +38,48 @@ pub struct ReceiverRegions {
     pub n_discontinuity: u64,
     /// Faces after merging across dropped edges: the paper's N_f2.
     pub n_regions: u64,
+    /// Lines across which light jumps whatever the relations say (contact lines and plane
+    /// cuts, D0), in the receiver's frame: the mesh keeps vertex rows apart there, and
+    /// elements shrink towards their ends.
+    pub d0_lines: Vec<[DVec2; 2]>,
+    /// The receiver's shadows, for the relation of any point.
+    classifier: Classifier,
 }
 
-/// Shadow polygons with their bounding boxes in a grid, for a cheap first test.
-pub struct Indexed<'a> {
-    polys: &'a [ShadowPolygon],
+impl ReceiverRegions {
+    /// Relation and blockers of the point `q` (strictly inside some region).
+    pub fn classify(&self, q: DVec2) -> RegionFace {
+        self.classifier.classify(q)
+    }
+}
+
+/// A receiver's shadow polygons with their bounding boxes in a grid, for a cheap first test.
+#[derive(Debug, Clone)]
+struct Classifier {
+    polys: Vec<ShadowPolygon>,
     boxes: Vec<(DVec2, DVec2)>,
     grid: BoxGrid,
     /// Parts of the receiver inside closed solids.
-    inside: &'a [Vec<DVec2>],
+    inside: Vec<Vec<DVec2>>,
+    exposure: Vec<Exposure>,
 }
 
-impl<'a> Indexed<'a> {
-    pub fn new(polys: &'a [ShadowPolygon], inside: &'a [Vec<DVec2>]) -> Self {
+impl Classifier {
+    fn new(polys: Vec<ShadowPolygon>, inside: Vec<Vec<DVec2>>, exposure: Vec<Exposure>) -> Self {
         let boxes: Vec<(DVec2, DVec2)> = polys.iter().map(|p| bounds(&p.poly)).collect();
         let grid = BoxGrid::new(&boxes);
-        Indexed {
+        Classifier {
             polys,
             boxes,
             grid,
             inside,
+            exposure,
         }
     }
 
     /// Relation and blockers of the point `q` (strictly inside some arrangement face).
-    pub fn classify(&self, q: DVec2, exposure: &[Exposure]) -> RegionFace {
+    fn classify(&self, q: DVec2) -> RegionFace {
+        let exposure = &self.exposure;
         let n = exposure.len();
         let mut relations = vec![Relation::Lit; n];
         let mut blockers = vec![Vec::new(); n];
@@ -116,11 +133,6 @@ impl<'a> Indexed<'a> {
     }
 }
 
-/// Relation of a point to all lights, from the receiver's shadow polygons (exact tests).
-pub fn classify_point(sh: &ReceiverShadows, q: DVec2) -> RegionFace {
-    Indexed::new(&sh.polys, &sh.inside).classify(q, &sh.exposure)
-}
-
 pub struct RegionTimes {
     pub t_idd: f64,
     pub t_lop: f64,
@@ -130,10 +142,10 @@ pub struct RegionTimes {
 
 pub fn build_regions(
     r: &Face,
-    sh: &ReceiverShadows,
+    sh: ReceiverShadows,
     diag: f64,
     uniform: bool,
-    indirect: bool,
+    keep_contacts: bool,
 ) -> (ReceiverRegions, RegionTimes) {
     if uniform {
         return (
@@ -191,7 +203,7 @@ pub fn build_regions(
     let n_events = sh.events.len() as u32;
     // Contacts too when indirect light follows: where a solid meets the receiver in umbra on
     // both sides, bounced light still reaches the side outside it and never the inside.
-    let contacts: &[[DVec2; 2]] = if indirect { &sh.contacts } else { &[] };
+    let contacts: &[[DVec2; 2]] = if keep_contacts { &sh.contacts } else { &[] };
     for (k, [a, b]) in sh.plane_cuts.iter().chain(contacts).enumerate() {
         segs.push(Segment {
             a: *a,
@@ -205,11 +217,11 @@ pub fn build_regions(
     let t_lop = t1.elapsed().as_secs_f64();
 
     let t2 = std::time::Instant::now();
-    let index = Indexed::new(&sh.polys, &sh.inside);
+    let classifier = Classifier::new(sh.polys, sh.inside, sh.exposure);
     let faces: Vec<RegionFace> = arr
         .faces
         .iter()
-        .map(|f| index.classify(f.interior, &sh.exposure))
+        .map(|f| classifier.classify(f.interior))
         .collect();
     let t_lit = t2.elapsed().as_secs_f64();
 
@@ -230,14 +242,14 @@ pub fn build_regions(
     // every light.
     let light_of = |t: u32| {
         if t < n_polys {
-            Some(sh.polys[t as usize].light)
+            Some(classifier.polys[t as usize].light)
         } else if t < n_polys + n_events {
             Some(sh.events[(t - n_polys) as usize].0)
         } else {
             None
         }
     };
-    let n_lights = sh.exposure.len();
+    let n_lights = classifier.exposure.len();
     let mut merged = UnionFind::new(arr.faces.len());
     let mut kept = Vec::new();
     let mut n_disc = 0u64;
@@ -257,7 +269,7 @@ pub fn build_regions(
                 match light_of(t) {
                     Some(l) => both_umbra(l as usize),
                     // Solid on one side, open floor on the other: indirect light differs.
-                    None if indirect => false,
+                    None if keep_contacts => false,
                     None => (0..n_lights).all(both_umbra),
                 }
             });
@@ -278,6 +290,8 @@ pub fn build_regions(
             kept_edges: kept,
             n_discontinuity: n_disc,
             n_regions,
+            d0_lines: sh.contacts.into_iter().chain(sh.plane_cuts).collect(),
+            classifier,
         },
         RegionTimes {
             t_idd,
@@ -291,7 +305,7 @@ pub fn build_regions(
 /// The whole receiver as one region, for uniform meshing: every light that reaches it is
 /// treated as penumbra with every occluder that shadows any part of it as candidate, so the
 /// light at each vertex is still exact.
-fn uniform_regions(r: &Face, sh: &ReceiverShadows, diag: f64) -> ReceiverRegions {
+fn uniform_regions(r: &Face, sh: ReceiverShadows, diag: f64) -> ReceiverRegions {
     let extent = r.extent(diag);
     let arr = arrangement::build(&r.poly2, &[], 1e-9 * extent);
     let n = sh.exposure.len();
@@ -327,6 +341,8 @@ fn uniform_regions(r: &Face, sh: &ReceiverShadows, diag: f64) -> ReceiverRegions
         kept_edges: kept,
         n_discontinuity: 0,
         n_regions: 1,
+        d0_lines: sh.contacts.into_iter().chain(sh.plane_cuts).collect(),
+        classifier: Classifier::new(sh.polys, sh.inside, sh.exposure),
     }
 }
 

@@ -112,3 +112,44 @@ impl Scene {
         (self.bounds_max - self.bounds_min).length()
     }
 }
+
+impl crate::geom::PlanarPolygon for Face {
+    fn verts(&self) -> &[DVec3] {
+        &self.verts
+    }
+    fn plane(&self) -> Plane {
+        self.plane
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod test {
+    use glam::DVec3;
+
+    use super::Face;
+    use crate::geom::polygon::signed_area_2d;
+    use crate::geom::{Frame, Plane};
+
+    /// A face from counter-clockwise (seen from the front) vertices.
+    pub(crate) fn face(verts: &[DVec3], albedo: DVec3, emission: DVec3) -> Face {
+        let plane = Plane::from_polygon(verts).expect("face has area");
+        let verts: Vec<DVec3> = verts
+            .iter()
+            .map(|v| *v - plane.n * plane.dist(*v))
+            .collect();
+        let frame = Frame::on_plane(&plane, verts[0]);
+        let poly2: Vec<_> = verts.iter().map(|v| frame.to_2d(*v)).collect();
+        let area = signed_area_2d(&poly2);
+        Face {
+            mesh: 0,
+            source_polygon: 0,
+            verts,
+            plane,
+            frame,
+            poly2,
+            albedo,
+            emission,
+            area,
+        }
+    }
+}

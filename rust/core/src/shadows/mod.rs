@@ -103,6 +103,7 @@ fn occluder_outline(occ: &Occluder, faces: &[Face]) -> (Vec<DVec3>, Vec<[DVec3; 
 /// Shadow polygons on every receiver for every light.
 pub fn shadow_polygons(
     scene: &Scene,
+    keep_contacts: bool,
     progress: &crate::Progress,
 ) -> Result<(Vec<ReceiverShadows>, EdgeStats), crate::BakeError> {
     let eps = 1e-12 * scene.diagonal().max(1e-300);
@@ -231,7 +232,7 @@ pub fn shadow_polygons(
     per_receiver.par_iter_mut().zip(faces).for_each(|(r, f)| {
         crate::shadows::umbra_pruning::drop_covered(&mut r.polys, &r.inside);
         let snap = 1e-9 * f.extent(scene.diagonal());
-        crate::shadows::umbra_pruning::trim_lines(r, snap, !scene.settings.indirect);
+        crate::shadows::umbra_pruning::trim_lines(r, snap, !keep_contacts);
     });
     stats.t_isr += t2.elapsed().as_secs_f64();
     Ok((per_receiver, stats))

@@ -85,7 +85,7 @@ pub fn drop_covered(polys: &mut Vec<ShadowPolygon>, inside: &[Vec<DVec2>]) {
 /// Cuts the lines that belong to every light on one receiver (plane cuts, contacts) where
 /// they lie deep inside a part covered for every light (see `UmbraCover`), and critical
 /// lines where they lie deep inside an umbra of their light. `snap` is the arrangement's
-/// snapping distance on this receiver; `direct_only`: no indirect light will be computed.
+/// snapping distance on this receiver; `direct_only`: contacts and plane cuts need not stay (no indirect light follows).
 pub fn trim_lines(sh: &mut ReceiverShadows, snap: f64, direct_only: bool) {
     if sh.inside.is_empty() && sh.polys.is_empty() {
         return;

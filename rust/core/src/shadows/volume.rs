@@ -38,6 +38,7 @@ impl Volume {
         &self.planes[..self.planes.len() - self.cap.min(self.planes.len())]
     }
 
+    #[cfg(test)]
     pub fn contains(&self, p: DVec3, eps: f64) -> bool {
         self.planes.iter().all(|h| h.dist(p) >= -eps)
     }

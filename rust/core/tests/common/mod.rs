@@ -274,17 +274,11 @@ pub fn check_coverage(s: &SceneJson, b: &Bake) {
 
 /// A closed axis-aligned box (outward faces) as polygons.
 pub fn cuboid(lo: [f64; 3], hi: [f64; 3]) -> Vec<Vec<[f64; 3]>> {
-    let [x0, y0, z0] = lo;
-    let [x1, y1, z1] = hi;
-    vec![
-        vec![[x0, y0, z0], [x0, y1, z0], [x1, y1, z0], [x1, y0, z0]],
-        vec![[x0, y0, z1], [x1, y0, z1], [x1, y1, z1], [x0, y1, z1]],
-        vec![[x0, y0, z0], [x1, y0, z0], [x1, y0, z1], [x0, y0, z1]],
-        vec![[x1, y1, z0], [x0, y1, z0], [x0, y1, z1], [x1, y1, z1]],
-        vec![[x1, y0, z0], [x1, y1, z0], [x1, y1, z1], [x1, y0, z1]],
-        vec![[x0, y1, z0], [x0, y0, z0], [x0, y0, z1], [x0, y1, z1]],
-    ]
+    penumbra::scenes::cuboid(lo, hi, false)
 }
+
+#[allow(unused_imports)]
+pub use penumbra::scenes::uv_sphere;
 
 /// Every one of a spread of points on the light (its vertices pulled a hair inside, and a
 /// grid over its fan) is hidden from p by some polygon: the union of occluders hides it.
@@ -308,39 +302,6 @@ pub fn all_samples_blocked<'a>(
     samples
         .iter()
         .all(|&q| occ.clone().any(|o| segment_hits(p, q, o)))
-}
-
-/// A UV sphere with `seg` segments and `rings` rings, faces outward, vertices shared.
-pub fn uv_sphere(c: [f64; 3], r: f64, seg: usize, rings: usize) -> Vec<Vec<[f64; 3]>> {
-    let pt = |i: usize, j: usize| -> [f64; 3] {
-        let th = std::f64::consts::PI * j as f64 / rings as f64;
-        let ph = std::f64::consts::TAU * (i % seg) as f64 / seg as f64;
-        if j == 0 {
-            return [c[0], c[1], c[2] + r];
-        }
-        if j == rings {
-            return [c[0], c[1], c[2] - r];
-        }
-        [
-            c[0] + r * th.sin() * ph.cos(),
-            c[1] + r * th.sin() * ph.sin(),
-            c[2] + r * th.cos(),
-        ]
-    };
-    let mut out = Vec::new();
-    for j in 0..rings {
-        for i in 0..seg {
-            let (a, b, cc, d) = (pt(i, j), pt(i + 1, j), pt(i + 1, j + 1), pt(i, j + 1));
-            if j == 0 {
-                out.push(vec![a, d, cc]);
-            } else if j == rings - 1 {
-                out.push(vec![a, d, b]);
-            } else {
-                out.push(vec![a, d, cc, b]);
-            }
-        }
-    }
-    out
 }
 
 /// Positions that occur more than once in a mesh (to 1e-9): D0 rows.

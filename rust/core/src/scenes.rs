@@ -1,9 +1,10 @@
-//! Scene builders. Each returns scene JSON v1 (see the README) in Blender's conventions:
+//! Built-in scenes (the paper's test data, the Cornell box, the demo room) for the CLI's `scene`
+//! command, the benchmarks and the tests. Each returns scene JSON v1 (see the README) in Blender's conventions:
 //! metres, Z up, polygons counter-clockwise seen from their front.
 
 use std::f64::consts::{PI, TAU};
 
-use penumbra::scene::json::{LightJson, MeshJson, PerPolygon, SceneJson, SettingsJson};
+use crate::scene::json::{LightJson, MeshJson, PerPolygon, SceneJson, SettingsJson};
 
 type P = [f64; 3];
 
