@@ -21,7 +21,7 @@ use crate::shadows;
 
 use crate::progress::Progress;
 use crate::scene::json::SceneJson;
-use crate::scene::Scene;
+use crate::scene::{Scene, Tolerances};
 use crate::BakeError;
 
 /// Figures named as in the paper's tables (times in seconds).
@@ -126,7 +126,8 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
     // Contact lines and plane cuts stay discontinuities even in umbra on both sides when
     // indirect light follows: bounced light reaches the floor beside a box, never under it.
     let keep_contacts = scene.settings.indirect;
-    let (shadows, es) = shadows::shadow_polygons(scene, keep_contacts, progress)?;
+    let tol = scene.tolerances();
+    let (shadows, es) = shadows::shadow_polygons(scene, &tol, keep_contacts, progress)?;
     stats.T_sdw = es.t_sdw;
     stats.T_isr = es.t_isr;
     stats.shadow_pairs = es.shadow_pairs;
@@ -135,12 +136,11 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
     progress.stage("discontinuity loops");
     progress.check()?;
     let t = Instant::now();
-    let diag = scene.diagonal();
     let built: Vec<(ReceiverRegions, RegionTimes)> = scene
         .faces
         .par_iter()
         .zip(shadows)
-        .map(|(f, sh)| regions::build_regions(f, sh, diag, scene.settings.uniform, keep_contacts))
+        .map(|(f, sh)| regions::build_regions(f, sh, &tol, scene.settings.uniform, keep_contacts))
         .collect();
     // Stage times are wall time, split between sub-stages by their share of CPU time.
     let wall = t.elapsed().as_secs_f64();
@@ -171,7 +171,7 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
         .map(|(rr, f)| {
             progress.check()?;
             let sizing = Sizing::new(f, &scene.lights, &scene.settings);
-            mesh::mesh_receiver(rr, &sizing, &scene.settings, diag, &budget)
+            mesh::mesh_receiver(rr, &sizing, &scene.settings, &tol, &budget)
         })
         .collect::<Result<_, _>>()?;
     let elements = assemble(scene, &meshes);
@@ -181,7 +181,7 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
 
     progress.stage("direct light");
     let t = Instant::now();
-    let (direct, pairs) = direct::direct_irradiance(scene, &elements, progress)?;
+    let (direct, pairs) = direct::direct_irradiance(scene, &tol, &elements, progress)?;
     stats.T_direct = t.elapsed().as_secs_f64();
     [stats.pairs_umbra, stats.pairs_lit, stats.pairs_penumbra] = pairs;
 
@@ -201,7 +201,7 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
         }
     }
     let radiance = colors(scene, &elements, &irradiance);
-    let out = output(scene, &elements, &radiance);
+    let out = output(scene, &tol, &elements, &radiance);
     stats.T_total = t_start.elapsed().as_secs_f64();
     Ok(Bake {
         format: "penumbra-bake",
@@ -262,8 +262,8 @@ fn colors(scene: &Scene, el: &Elements, irradiance: &[DVec3]) -> Vec<[f64; 3]> {
 /// polygon split into convex pieces, or a flat floor of many quads, comes out as one
 /// connected surface. D0 rows keep their two vertices (their colours differ), and so do
 /// creases (their normals differ).
-fn weld(scene: &Scene, el: &Elements, colors: &[[f64; 3]]) -> Vec<u32> {
-    let q = 1e-9 * scene.diagonal().max(1e-300);
+fn weld(scene: &Scene, tol: &Tolerances, el: &Elements, colors: &[[f64; 3]]) -> Vec<u32> {
+    let q = tol.weld;
     let cmax = colors
         .iter()
         .flat_map(|c| c.iter())
@@ -296,7 +296,7 @@ fn weld(scene: &Scene, el: &Elements, colors: &[[f64; 3]]) -> Vec<u32> {
 }
 
 /// Splits the scene-wide elements back into one mesh per input mesh.
-fn output(scene: &Scene, el: &Elements, colors: &[[f64; 3]]) -> Vec<BakedMesh> {
+fn output(scene: &Scene, tol: &Tolerances, el: &Elements, colors: &[[f64; 3]]) -> Vec<BakedMesh> {
     let mut out: Vec<BakedMesh> = scene
         .meshes
         .iter()
@@ -305,7 +305,7 @@ fn output(scene: &Scene, el: &Elements, colors: &[[f64; 3]]) -> Vec<BakedMesh> {
             ..BakedMesh::default()
         })
         .collect();
-    let canon = weld(scene, el, colors);
+    let canon = weld(scene, tol, el, colors);
     let mut remap = vec![u32::MAX; el.positions.len()];
     for (t, tri) in el.triangles.iter().enumerate() {
         let f = &scene.faces[el.tri_face[t] as usize];

@@ -1,8 +1,9 @@
 //! Penumbra: discontinuity meshing and radiosity after Itoh, Shimada & Doi (1995), with exact
 //! direct light. See `ARCHITECTURE.md` beside this crate for the pipeline.
 //!
-//! The pipeline runs one direction: `scene` → `shadow` → `edges` → `arrangement`/`relation`
-//! → `mesh` → `direct` → `indirect` → `bake` (output).
+//! The pipeline runs one direction, one folder a stage: `scene` → `shadows` → `regions` →
+//! `mesh` → `direct` → `indirect` → `bake` (output); `geom` is shared geometry and depends on
+//! nothing above it.
 
 // The pipeline, in order (see ARCHITECTURE.md). Public: what the CLI, the binding and the
 // tests use (the input format, the bake and its output, the built-in scenes, the exact direct

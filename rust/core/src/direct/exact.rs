@@ -1,4 +1,4 @@
-//! Stage 6: direct irradiance (W/m², per RGB channel) at a receiver point, per light, driven
+//! The exact direct light: irradiance (W/m², per RGB channel) at a receiver point, per light, driven
 //! by the region's relation to that light (paper 2.6): umbra costs nothing, lit is one exact
 //! Lambert integral, and only penumbra (or an unprocessed region) looks at the occluders.
 //!

@@ -1,4 +1,4 @@
-//! Stage 7: direct light at every element vertex, driven by the relations (paper 2.6 (1)).
+//! Stage `direct` (T_direct): direct light at every element vertex, driven by the relations (paper 2.6 (1)).
 //! A vertex takes the relations of the triangles around it (after the D0 split, only those
 //! of its own side): umbra everywhere → nothing to do; lit everywhere → the unoccluded
 //! integral; otherwise the exact visible part of the light, with only the occluders whose
@@ -14,12 +14,13 @@ use crate::geom::{Frame, Plane};
 use crate::mesh::elements::Elements;
 use crate::regions::relation::Relation;
 use crate::scene::solids::{Occluder, Solid};
-use crate::scene::{LightKind, Scene};
+use crate::scene::{LightKind, Scene, Tolerances};
 
 /// Direct irradiance (W/m², RGB) per vertex, and the vertex×light counts
 /// (umbra skipped, lit, penumbra).
 pub fn direct_irradiance(
     scene: &Scene,
+    tol: &Tolerances,
     el: &Elements,
     progress: &crate::Progress,
 ) -> Result<(Vec<DVec3>, [u64; 3]), crate::BakeError> {
@@ -44,7 +45,7 @@ pub fn direct_irradiance(
             let mut regions: Vec<u32> = around[count[v] as usize..count[v + 1] as usize].to_vec();
             regions.sort_unstable();
             regions.dedup();
-            vertex_direct(scene, el, v, &regions)
+            vertex_direct(scene, tol, el, v, &regions)
         })
         .collect();
     progress.check()?;
@@ -61,7 +62,13 @@ pub fn direct_irradiance(
     Ok((e, counts))
 }
 
-fn vertex_direct(scene: &Scene, el: &Elements, v: usize, regions: &[u32]) -> (DVec3, [u64; 3]) {
+fn vertex_direct(
+    scene: &Scene,
+    tol: &Tolerances,
+    el: &Elements,
+    v: usize,
+    regions: &[u32],
+) -> (DVec3, [u64; 3]) {
     let p = el.eval[v];
     let n = el.normals[v];
     let mut e = DVec3::ZERO;
@@ -105,7 +112,7 @@ fn vertex_direct(scene: &Scene, el: &Elements, v: usize, regions: &[u32]) -> (DV
         let mut face_refs: Vec<u32> = Vec::new();
         // A point inside a closed solid (a receiver passing through it) sees no light. The
         // margin keeps points on a solid's surface (contacts) outside.
-        let margin = 1e-12 * scene.diagonal();
+        let margin = tol.flat;
         let buried = occ.iter().any(|&o| match &scene.occluders[o as usize] {
             Occluder::Solid { solid, .. } => solid.planes.iter().all(|f| f.dist(p) < -margin),
             Occluder::Face(_) => false,

@@ -1,4 +1,4 @@
-//! Stage 6 (paper 2.5): elements. Per receiver, a constrained Delaunay triangulation (spade)
+//! Stage `mesh` (paper 2.5, T_m): elements. Per receiver, a constrained Delaunay triangulation (spade)
 //! that conforms to every kept discontinuity edge and the receiver boundary. Nodes are seeded
 //! on a lattice whose spacing depends on the region (fine in penumbra) and shrinks near the
 //! lights (`sizing`), then Delaunay refinement fixes angles. Edges across which some light jumps from lit to umbra (D0:
@@ -24,6 +24,7 @@ use crate::regions::arrangement::ArrFace;
 use crate::regions::relation::Relation;
 use crate::regions::{ReceiverRegions, RegionFace};
 use crate::scene::settings::Settings;
+use crate::scene::Tolerances;
 use crate::BakeError;
 
 /// The element mesh of one receiver, in its 2-D frame.
@@ -41,14 +42,14 @@ pub struct ReceiverMesh {
 type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
 
 /// Meshes one receiver. `budget` counts vertices over the whole scene so that a bake that
-/// would exceed `max_elements` stops early with a clear error. `diag` is the scene's size:
-/// evaluation points on D0 rows move at least 1e-9 of it off the line, so that the exact
-/// side tests of the light stages see them on their own side.
+/// would exceed `max_elements` stops early with a clear error. Evaluation points on D0 rows
+/// move at least `tol.d0_offset` off the line, so that the exact side tests of the light
+/// stages see them on their own side.
 pub fn mesh_receiver(
     rr: &ReceiverRegions,
     sizing: &Sizing,
     settings: &Settings,
-    diag: f64,
+    tol: &Tolerances,
     budget: &AtomicU64,
 ) -> Result<ReceiverMesh, BakeError> {
     let arr = &rr.arrangement;
@@ -125,14 +126,14 @@ pub fn mesh_receiver(
         Ordering::Relaxed,
     );
     if settings.uniform {
-        let mut m = extract(&cdt, rr, sizing.frame(), true, diag);
+        let mut m = extract(&cdt, rr, sizing.frame(), true, tol);
         m.regions = vec![rr.faces.first().cloned().unwrap_or(RegionFace {
             relations: Vec::new(),
             blockers: Vec::new(),
         })];
         return Ok(m);
     }
-    Ok(extract(&cdt, rr, sizing.frame(), false, diag))
+    Ok(extract(&cdt, rr, sizing.frame(), false, tol))
 }
 
 /// Ends of D0 lines (the feet of a box on the floor, where a solid passes through): there
@@ -309,7 +310,7 @@ fn extract(
     rr: &ReceiverRegions,
     frame: &Frame,
     uniform: bool,
-    diag: f64,
+    tol: &Tolerances,
 ) -> ReceiverMesh {
     let nv = cdt.num_vertices();
     let mut positions: Vec<DVec2> = cdt
@@ -330,7 +331,7 @@ fn extract(
     // Components across unconstrained edges.
     if uniform {
         let mut tri_region = vec![0; triangles.len()];
-        drop_flat(&positions, frame, &mut triangles, &mut tri_region, diag);
+        drop_flat(&positions, frame, &mut triangles, &mut tri_region, tol);
         return ReceiverMesh {
             eval: positions.clone(),
             positions,
@@ -488,7 +489,7 @@ fn extract(
                 }
             }
             if dir != DVec2::ZERO && shortest.is_finite() {
-                let step = (shortest * 1e-6).max(1e-9 * diag).min(0.25 * shortest);
+                let step = (shortest * 1e-6).max(tol.d0_offset).min(0.25 * shortest);
                 eval[id as usize] = p + dir.normalize() * step;
             }
             if k > 0 {
@@ -504,7 +505,7 @@ fn extract(
     }
     let _ = nv;
     let mut tri_region = comp;
-    drop_flat(&positions, frame, &mut triangles, &mut tri_region, diag);
+    drop_flat(&positions, frame, &mut triangles, &mut tri_region, tol);
     ReceiverMesh {
         positions,
         eval,
@@ -530,14 +531,14 @@ fn drop_flat(
     frame: &Frame,
     triangles: &mut Vec<[u32; 3]>,
     tri_region: &mut Vec<u32>,
-    diag: f64,
+    tol: &Tolerances,
 ) {
     // Judged in 3-D: far from the origin, points apart in the receiver's frame can round
     // to one point in the scene.
     let p3: Vec<DVec3> = positions.iter().map(|p| frame.to_3d(*p)).collect();
     let scale = p3.iter().fold(0.0f64, |m, p| m.max(p.abs().max_element()));
     // Rounding alone moves a point off a line by a few ulps of the coordinates.
-    let tol = (64.0 * f64::EPSILON * scale).max(1e-12 * diag);
+    let tol = (64.0 * f64::EPSILON * scale).max(tol.flat);
     let keep: Vec<bool> = triangles
         .iter()
         .map(|t| {

@@ -1,4 +1,4 @@
-//! Stages 4–5 (paper 2.3–2.4): per receiver, the arrangement of discontinuity edges and the
+//! Stage `regions` (paper 2.3–2.4; T_idd, T_lop, T_lit, T_div): per receiver, the arrangement of discontinuity edges and the
 //! receiver boundary, split into faces bounded by loops, each with its relation to every
 //! light. Edges that separate two faces which are both in umbra of every light that made the
 //! edge are no discontinuity at all (the mosaic of one closed mesh's face shadows inside its
@@ -13,7 +13,7 @@ use crate::geom::box_grid::{bounds, BoxGrid};
 use crate::geom::polygon::inside_convex;
 use crate::geom::union_find::UnionFind;
 use crate::regions::relation::Relation;
-use crate::scene::Face;
+use crate::scene::{Face, Tolerances};
 use crate::shadows::umbra_pruning::UmbraCover;
 use crate::shadows::{Exposure, ReceiverShadows, ShadowPolygon};
 use arrangement::{Arrangement, Segment, BOUNDARY_TAG};
@@ -143,13 +143,13 @@ pub struct RegionTimes {
 pub fn build_regions(
     r: &Face,
     sh: ReceiverShadows,
-    diag: f64,
+    tol: &Tolerances,
     uniform: bool,
     keep_contacts: bool,
 ) -> (ReceiverRegions, RegionTimes) {
     if uniform {
         return (
-            uniform_regions(r, sh, diag),
+            uniform_regions(r, sh, tol),
             RegionTimes {
                 t_idd: 0.0,
                 t_lop: 0.0,
@@ -159,8 +159,7 @@ pub fn build_regions(
         );
     }
     let t0 = std::time::Instant::now();
-    let extent = r.extent(diag);
-    let snap = 1e-9 * extent;
+    let snap = tol.snap(r);
     // Parts of edges deep inside an umbra of their own light would only be dropped again
     // after the arrangement; a few snap distances keep rounding off the umbra boundaries.
     // Every segment cut here carries its light, so the only-light rule never applies.
@@ -171,7 +170,7 @@ pub fn build_regions(
         for i in 0..p.poly.len() {
             let a = p.poly[i];
             let b = p.poly[(i + 1) % p.poly.len()];
-            if a != b && !on_boundary(&r.poly2, a, b, 1e-10 * diag) {
+            if a != b && !on_boundary(&r.poly2, a, b, tol.boundary) {
                 pieces.clear();
                 cover.uncovered(
                     a,
@@ -305,9 +304,8 @@ pub fn build_regions(
 /// The whole receiver as one region, for uniform meshing: every light that reaches it is
 /// treated as penumbra with every occluder that shadows any part of it as candidate, so the
 /// light at each vertex is still exact.
-fn uniform_regions(r: &Face, sh: ReceiverShadows, diag: f64) -> ReceiverRegions {
-    let extent = r.extent(diag);
-    let arr = arrangement::build(&r.poly2, &[], 1e-9 * extent);
+fn uniform_regions(r: &Face, sh: ReceiverShadows, tol: &Tolerances) -> ReceiverRegions {
+    let arr = arrangement::build(&r.poly2, &[], tol.snap(r));
     let n = sh.exposure.len();
     let mut rf = RegionFace {
         relations: vec![Relation::Lit; n],

@@ -1,10 +1,11 @@
-//! Stage 1: the validated scene. Input polygons become convex planar `Face`s (receivers and
+//! Stage `scene`: the validated scene. Input polygons become convex planar `Face`s (receivers and
 //! occluders alike) that remember their source polygon; lights become `Light`s.
 
 pub mod convex;
 pub mod json;
 pub mod settings;
 pub mod solids;
+pub mod tolerances;
 pub mod validate;
 
 use glam::{DVec2, DVec3};
@@ -12,6 +13,7 @@ use glam::{DVec2, DVec3};
 use crate::geom::{Frame, Plane};
 use crate::scene::settings::Settings;
 
+pub use tolerances::Tolerances;
 pub use validate::validate;
 
 /// A convex planar piece of an input polygon: the unit every later stage works on.
@@ -110,6 +112,11 @@ pub struct Scene {
 impl Scene {
     pub fn diagonal(&self) -> f64 {
         (self.bounds_max - self.bounds_min).length()
+    }
+
+    /// The scene's tolerances (`tolerances`), from its diagonal.
+    pub fn tolerances(&self) -> Tolerances {
+        Tolerances::new(self.diagonal())
     }
 }
 

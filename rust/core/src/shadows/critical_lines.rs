@@ -11,7 +11,7 @@ use glam::{DVec2, DVec3};
 use crate::geom::polygon::clip_polygon_3d;
 use crate::geom::Plane;
 use crate::scene::solids::Occluder;
-use crate::scene::Face;
+use crate::scene::{Face, Tolerances};
 
 /// Central projection of `x` from `l` onto the receiver's plane, if the ray from l through x
 /// reaches it beyond x.
@@ -59,10 +59,10 @@ pub fn critical_segments(
     faces: &[Face],
     r: &Face,
     pen: &[DVec2],
-    eps: f64,
+    tol: &Tolerances,
     out: &mut Vec<[DVec2; 2]>,
 ) {
-    let min_len = 1e3 * eps;
+    let (eps, min_len) = (tol.eps, tol.touch);
     let mut push = |a: DVec2, b: DVec2| {
         if let Some((a, b)) = clip_to_convex(a, b, pen) {
             if (b - a).length() > min_len {

@@ -1,4 +1,4 @@
-//! Stage 3 (paper 2.2): discontinuity edges. Every shadow volume is intersected with the
+//! Stage `shadows` (paper 2.1–2.2; T_sdw, T_isr): discontinuity edges. Every shadow volume is intersected with the
 //! receivers it can reach (found through a box tree, never all pairs); on a receiver the
 //! intersection is a convex polygon in the receiver's 2-D frame, whose edges are the
 //! discontinuity edges.
@@ -17,7 +17,7 @@ use rayon::prelude::*;
 use crate::geom::bvh::{Aabb, BoxTree};
 use crate::geom::polygon::{clip_polygon_3d, inside_convex, signed_area_2d};
 use crate::scene::solids::Occluder;
-use crate::scene::{Face, LightKind, Scene};
+use crate::scene::{Face, LightKind, Scene, Tolerances};
 use crate::shadows::critical_lines::critical_segments;
 use crate::shadows::culling::{screen_faces, screened};
 use crate::shadows::plane_cuts::{inside_solid, plane_cut};
@@ -103,10 +103,11 @@ fn occluder_outline(occ: &Occluder, faces: &[Face]) -> (Vec<DVec3>, Vec<[DVec3; 
 /// Shadow polygons on every receiver for every light.
 pub fn shadow_polygons(
     scene: &Scene,
+    tol: &Tolerances,
     keep_contacts: bool,
     progress: &crate::Progress,
 ) -> Result<(Vec<ReceiverShadows>, EdgeStats), crate::BakeError> {
-    let eps = 1e-12 * scene.diagonal().max(1e-300);
+    let eps = tol.eps;
     let faces = &scene.faces;
     let occs = &scene.occluders;
     let tree = BoxTree::new(faces.iter().map(|f| Aabb::from_points(&f.verts)).collect());
@@ -198,7 +199,7 @@ pub fn shadow_polygons(
                     &outlines,
                     &volumes,
                     &hits[ri],
-                    eps,
+                    tol,
                 )
             })
             .collect();
@@ -231,7 +232,7 @@ pub fn shadow_polygons(
     let t2 = std::time::Instant::now();
     per_receiver.par_iter_mut().zip(faces).for_each(|(r, f)| {
         crate::shadows::umbra_pruning::drop_covered(&mut r.polys, &r.inside);
-        let snap = 1e-9 * f.extent(scene.diagonal());
+        let snap = tol.snap(f);
         crate::shadows::umbra_pruning::trim_lines(r, snap, !keep_contacts);
     });
     stats.t_isr += t2.elapsed().as_secs_f64();
@@ -270,8 +271,9 @@ fn receiver_polygons(
     outlines: &[(Vec<DVec3>, Vec<[DVec3; 2]>)],
     volumes: &[Vec<ShadowVolumes>],
     hits: &[u32],
-    eps: f64,
+    tol: &Tolerances,
 ) -> OnReceiver {
+    let eps = tol.eps;
     let Some(clipped_light) = light_in_front(kind, r, eps) else {
         return OnReceiver::hidden();
     };
@@ -280,7 +282,7 @@ fn receiver_polygons(
     let mut plane_cuts = Vec::new();
     let mut inside = Vec::new();
     let mut events = Vec::new();
-    let touch = 1e3 * eps;
+    let touch = tol.touch;
     if let LightKind::Area { plane, .. } = kind {
         // Points of the receiver behind the light's plane get nothing from it.
         if let Some(poly) = clip_to_volume(
@@ -322,7 +324,7 @@ fn receiver_polygons(
             }
         }
         if let Occluder::Solid { solid, .. } = occ {
-            if let Some(p) = inside_solid(solid, r, eps) {
+            if let Some(p) = inside_solid(solid, r, tol) {
                 inside.push(p);
             }
         }
@@ -370,7 +372,7 @@ fn receiver_polygons(
                     if let (LightKind::Area { verts, plane, .. }, false) = (kind, sv.hard) {
                         let lv = clipped_light.as_deref().unwrap_or(verts);
                         let occ = &scene.occluders[oi as usize];
-                        critical_segments(lv, plane, occ, &scene.faces, r, &poly, eps, &mut events);
+                        critical_segments(lv, plane, occ, &scene.faces, r, &poly, tol, &mut events);
                     }
                     // Point/sun: the one volume is umbra and penumbra at once.
                     out.push(ShadowPolygon {

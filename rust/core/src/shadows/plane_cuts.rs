@@ -7,7 +7,7 @@
 use glam::{DVec2, DVec3};
 
 use crate::scene::solids::Solid;
-use crate::scene::Face;
+use crate::scene::{Face, Tolerances};
 use crate::shadows::volume::{clip_to_volume, Volume};
 
 /// The segment where convex occluder face `verts` crosses receiver `r`'s plane, clipped to
@@ -55,10 +55,10 @@ fn clip_segment_convex(a: DVec2, b: DVec2, poly: &[DVec2], tol: f64) -> Option<[
 
 /// The part of receiver `r` inside closed convex `solid` (a convex polygon in its frame), or
 /// `None` when the solid does not pass through it.
-pub fn inside_solid(solid: &Solid, r: &Face, eps: f64) -> Option<Vec<DVec2>> {
+pub fn inside_solid(solid: &Solid, r: &Face, tol: &Tolerances) -> Option<Vec<DVec2>> {
     // A solid only on one side of r's plane (perhaps with a face lying in it) has no
     // inside on r: touching is a contact, handled apart.
-    let touch = 1e3 * eps;
+    let (eps, touch) = (tol.eps, tol.touch);
     if solid.verts.iter().all(|v| r.plane.dist(*v) >= -touch)
         || solid.verts.iter().all(|v| r.plane.dist(*v) <= touch)
     {

@@ -1,4 +1,4 @@
-//! Stage 2 (paper 2.1): shadow volumes of every (light, occluder) pair that can cast a
+//! Shadow volumes (paper 2.1, T_sdw) of every (light, occluder) pair that can cast a
 //! shadow, as intersections of half-spaces.
 //!
 //! For a convex light L and convex occluder O, the penumbra volume
