@@ -2,4 +2,5 @@
 //! command and the benchmarks.
 
 pub mod gltf;
+pub mod images;
 pub mod scenes;

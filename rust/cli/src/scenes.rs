@@ -21,6 +21,7 @@ fn mesh(name: &str, polys: Vec<Vec<P>>, albedo: [f64; 3]) -> MeshJson {
         polygons,
         albedo: Some(PerPolygon::Uniform(albedo)),
         emission: None,
+        uv: None,
     }
 }
 

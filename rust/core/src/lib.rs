@@ -16,6 +16,7 @@ pub mod error;
 pub mod events;
 pub mod geom;
 pub mod indirect;
+pub mod lightmap;
 pub mod mesh;
 pub mod patches;
 pub mod progress;
