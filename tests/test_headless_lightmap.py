@@ -115,8 +115,8 @@ def test_lightmap_glb_binds_the_image_on_the_lightmap_uvs(tmp_path):
         for prim in mesh["primitives"]:
             mat = gltf["materials"][prim["material"]]
             tex = mat["emissiveTexture"]
-            coord = tex.get("texCoord", 0)
-            assert "TEXCOORD_%d" % coord in prim["attributes"], (mesh["name"], prim["attributes"])
+            # Engines read lightmaps from the second UV channel (Godot UV2, Unity uv2).
+            assert tex.get("texCoord", 0) == 1 and "TEXCOORD_1" in prim["attributes"], (mesh["name"], prim["attributes"])
             image = gltf["images"][gltf["textures"][tex["index"]]["source"]]
             assert image["name"].endswith("_radiosity")
     # The .blend keeps the originals, their packed images and no baked objects.

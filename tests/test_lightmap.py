@@ -180,3 +180,21 @@ def test_core_lightmap_binding_matches_a_hand_made_field():
     source["uv"] = source["uv"][:3]
     with pytest.raises(_core.BakeError, match='mesh "Quad": uv'):
         _core.check_lightmap_uv(source, 16, 4)
+
+
+def test_escape_during_a_lightmap_bake_takes_the_new_uv_maps_back(room_scene, empty, monkeypatch):
+    from test_addon import _Context, _Event, _modal_op
+
+    import penumbra.operators as ops
+
+    _lightmap_settings(empty.scene)
+    empty.scene.penumbra.quality = "HIGH"
+    before = full_snapshot()
+    op, ctx = _modal_op(), _Context()
+    monkeypatch.setattr(ops, "has_ui", lambda context: True)
+    assert op.invoke(ctx, _Event("NONE")) == {"RUNNING_MODAL"}
+    # The UV maps exist while the bake runs (the export read them) ...
+    assert "Lightmap" in bpy.data.objects["Floor"].data.uv_layers
+    assert op.modal(ctx, _Event("ESC", "PRESS")) == {"CANCELLED"}
+    # ... and are gone once it is cancelled.
+    assert full_snapshot() == before

@@ -17,6 +17,7 @@ import contextlib
 import bpy
 
 from . import lightmap_preview
+from .export import LIGHTMAP_UV
 from .import_ import ATTRIBUTE
 from .lightmaps import IMAGE_SUFFIX
 
@@ -62,12 +63,36 @@ def unlit_vertex_colours(objects):
         bpy.data.materials.remove(mat)
 
 
+def _second_uv_map(mesh):
+    """Makes the "Lightmap" UV map the mesh's second one, engines' lightmap channel
+    (TEXCOORD_1: Godot's UV2, Unity's uv2), when it is the only one: it is renamed and a copy
+    made under its name after it. Returns the undo, or None when nothing changed."""
+    if len(mesh.uv_layers) != 1 or mesh.uv_layers[0].name != LIGHTMAP_UV:
+        return None
+    first = mesh.uv_layers[0]
+    first.name = "UVMap"
+    copy = mesh.uv_layers.new(name=LIGHTMAP_UV)
+    data = [0.0] * (2 * len(mesh.loops))
+    first.data.foreach_get("uv", data)
+    copy.data.foreach_set("uv", data)
+
+    def undo():
+        mesh.uv_layers.remove(mesh.uv_layers[LIGHTMAP_UV])
+        mesh.uv_layers["UVMap"].name = LIGHTMAP_UV
+
+    return undo
+
+
 @contextlib.contextmanager
 def lightmapped(objects, images):
-    """While active, each object's materials are copies showing its lightmap image."""
-    copies, saved, added = [], [], []
+    """While active, each object's materials are copies showing its lightmap image, and
+    the "Lightmap" UV map is the mesh's second one."""
+    copies, saved, added, undos = [], [], [], []
     try:
         for obj, image in zip(objects, images):
+            undo = _second_uv_map(obj.data)
+            if undo is not None:
+                undos.append(undo)
             saved.append((obj, [s.material for s in obj.material_slots]))
             if not obj.material_slots:
                 mat = bpy.data.materials.new(obj.name + " (lightmap)")
@@ -92,3 +117,5 @@ def lightmapped(objects, images):
                 slot.material = m
         for mat in copies:
             bpy.data.materials.remove(mat)
+        for undo in reversed(undos):
+            undo()
