@@ -17,6 +17,13 @@ from penumbra.operators import bake_blocking
 RES = 32
 
 
+@pytest.fixture(autouse=True, scope="module")
+def _factory_scene_afterwards():
+    """Later test modules start from the factory scene, not from these settings."""
+    yield
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+
+
 def _lightmap_settings(scene, output="LIGHTMAP", res=RES):
     s = scene.penumbra
     s.output = output

@@ -33,6 +33,9 @@ def prepare(context, report):
         if settings.output != "MESH":
             lightmaps.check_uvs(export.scene["meshes"], settings.lightmap_resolution, settings.lightmap_margin)
         export.uv_maps = uv_maps
+        # What the bake was started for: settings changed while it runs do not apply to it.
+        export.output = settings.output
+        export.lightmap = (int(settings.lightmap_resolution), int(settings.lightmap_margin))
         return export
     except (ExportError, _core.BakeError) as e:
         uv_maps.undo()
@@ -62,22 +65,24 @@ def finish(context, export, result, seconds, report):
     kept = [i for i, s in enumerate(sources) if s is not None]
     pairs = [(result["meshes"][i], sources[i]) for i in kept]
     settings = context.scene.penumbra
+    output = getattr(export, "output", "MESH")
+    resolution, margin = getattr(export, "lightmap", (0, 0))
     maps = []
-    if settings.output != "MESH":
+    if output != "MESH":
         # Every lightmap is computed before anything is created: an error changes nothing.
         try:
             maps = lightmaps.compute(
                 [export.scene["meshes"][i] for i in kept],
                 [m for m, _ in pairs],
-                settings.lightmap_resolution,
-                settings.lightmap_margin,
+                resolution,
+                margin,
             )
         except _core.BakeError as e:
             abandon(export)
             report({"ERROR"}, "Penumbra: %s" % e)
             return {"CANCELLED"}
     created = []
-    if settings.output != "LIGHTMAP":
+    if output != "LIGHTMAP":
         created = import_bake(
             context, {"meshes": [m for m, _ in pairs]}, [s for _, s in pairs], settings.hide_originals
         )
@@ -89,7 +94,7 @@ def finish(context, export, result, seconds, report):
     stats = result["stats"]
     elements = stats.get("N_e") or sum(len(m["triangles"]) for m in result["meshes"])
     vertices = stats.get("N_v") or sum(len(m["positions"]) for m in result["meshes"])
-    n = len(created) if settings.output != "LIGHTMAP" else len(images)
+    n = len(created) if output != "LIGHTMAP" else len(images)
     summary = "Penumbra: baked %d object%s, %d elements, %d vertices in %.2f s" % (
         n,
         "" if n == 1 else "s",
@@ -98,7 +103,7 @@ def finish(context, export, result, seconds, report):
         seconds,
     )
     if images:
-        r = settings.lightmap_resolution
+        r = resolution
         summary += ", %d lightmap%s %d×%d" % (len(images), "" if len(images) == 1 else "s", r, r)
     warnings = list(export.warnings) + list(result["warnings"])
     if warnings:
