@@ -1,14 +1,19 @@
 """Headless bake of a .blend file.
 
     blender -b scene.blend --python scripts/bake.py -- --output baked.blend [--all] [--quality high] [--gltf baked.glb]
+    blender -b scene.blend --python scripts/bake.py -- --output baked.blend --lightmap 512 [--margin 16] [--gltf lit.glb]
     python scripts/bake.py scene.blend --output baked.blend [...]        (bpy module)
 
 Bakes the meshes selected in the file (every visible mesh with --all) with the selected
-lights (every visible light when none is selected), and writes the result. Exits non-zero
-with a one-line reason on any failure.
+lights (every visible light when none is selected), and writes the result. With
+--lightmap the light goes into an image per object on its "Lightmap" UV map instead of new
+objects (both with --both); --gltf then writes the original objects with the lightmap as
+their emissive texture on that UV map. Exits non-zero with a one-line reason on any failure.
 """
 
 import argparse
+import importlib
+import json
 import os
 import sys
 import traceback
@@ -30,6 +35,9 @@ def parse_args(argv):
     p.add_argument("--gltf", help="also write the baked objects as glTF binary (.glb)")
     p.add_argument("--no-indirect", action="store_true", help="direct light only")
     p.add_argument("--hide-originals", action="store_true", help="hide the source objects in the output")
+    p.add_argument("--lightmap", type=int, metavar="RES", help="bake RES×RES lightmap images instead of new objects")
+    p.add_argument("--margin", type=int, help="lightmap margin in texels (default 16)")
+    p.add_argument("--both", action="store_true", help="with --lightmap, make the new objects too")
     return p.parse_args(argv)
 
 
@@ -60,11 +68,14 @@ def _ensure_numpy():
 
 
 def ensure_addon():
-    """Registers the add-on from this checkout unless Blender already has it enabled."""
+    """Registers the add-on from this checkout unless Blender already has it enabled, and
+    returns its package name: "penumbra" as a legacy add-on or from this checkout,
+    "bl_ext.<repo>.penumbra" when installed as an extension (Blender 4.2+)."""
     import bpy
 
     if hasattr(bpy.types.Scene, "penumbra") and hasattr(bpy.ops.penumbra, "bake"):
-        return
+        # Regression: importing "penumbra.…" failed when the add-on ran as an extension.
+        return bpy.types.PENUMBRA_OT_bake.__module__.rpartition(".")[0]
     _ensure_numpy()
     addon = os.path.join(ROOT, "addon")
     if addon not in sys.path:
@@ -72,6 +83,7 @@ def ensure_addon():
     import penumbra
 
     penumbra.register()
+    return "penumbra"
 
 
 def export_gltf(objects, path):
@@ -111,9 +123,14 @@ def run(args):
         raise Failure("no .blend file open: give one (blender -b scene.blend --python ...) or as first argument")
     source = bpy.data.filepath
 
-    ensure_addon()
+    package = ensure_addon()
     context = bpy.context
     settings = context.scene.penumbra
+    if args.lightmap is not None:
+        settings.output = "BOTH" if args.both else "LIGHTMAP"
+        settings.lightmap_resolution = args.lightmap
+    if args.margin is not None:
+        settings.lightmap_margin = args.margin
     if args.quality:
         settings.quality = args.quality.upper()
     if args.no_indirect:
@@ -145,12 +162,20 @@ def run(args):
     bpy.ops.wm.save_as_mainfile(filepath=output, check_existing=False)
     print("Penumbra: wrote", output)
     if args.gltf:
-        from penumbra.import_ import COLLECTION
-
-        baked = list(bpy.data.collections[COLLECTION].objects)
+        # Only what this bake made: older bakes in the collection stay out of the file.
+        outputs = json.loads(settings.last_outputs or "{}")
         gltf = os.path.abspath(args.gltf)
         os.makedirs(os.path.dirname(gltf), exist_ok=True)
-        export_gltf(baked, gltf)
+        if settings.output == "MESH":
+            objects = [bpy.data.objects[n] for n in outputs.get("objects", [])]
+            gltf_out = importlib.import_module(package + ".gltf_out")
+            with gltf_out.unlit_vertex_colours(objects):
+                export_gltf(objects, gltf)
+        else:
+            gltf_out = importlib.import_module(package + ".gltf_out")
+            sources = [bpy.data.objects[n[: -len(gltf_out.IMAGE_SUFFIX)]] for n in outputs.get("images", [])]
+            with gltf_out.lightmapped(sources, [bpy.data.images[n] for n in outputs.get("images", [])]):
+                export_gltf(sources, gltf)
         print("Penumbra: wrote", gltf)
 
 

@@ -43,3 +43,23 @@ def test_legacy_addon_installs_in_blender_3_4(zips, tmp_path):
     ) + CHECK
     r = run([BLENDER, "-b", "--factory-startup", "--python-exit-code", "1", "--python-expr", code], {"BLENDER_USER_SCRIPTS": str(tmp_path)})
     assert "REGISTERED True" in r.stdout, r.stdout + r.stderr
+
+
+def _blender_ext():
+    """Blender's own extension tool, shipped inside the bpy wheel."""
+    import bpy
+
+    root = bpy.utils.system_resource("SCRIPTS")
+    for dirpath, _, files in os.walk(root):
+        if "blender_ext.py" in files and dirpath.endswith(os.path.join("bl_pkg", "cli")):
+            return os.path.join(dirpath, "blender_ext.py")
+    pytest.skip("blender_ext.py is not in this bpy wheel")
+
+
+def test_manifest_passes_blenders_validator():
+    # Regression: a tagline over 64 characters made Blender refuse the extension.
+    r = subprocess.run(
+        [sys.executable, _blender_ext(), "validate", os.path.join(ROOT, "addon", "penumbra")],
+        capture_output=True, text=True, timeout=120, stdin=subprocess.DEVNULL,
+    )
+    assert r.returncode == 0, r.stdout + r.stderr

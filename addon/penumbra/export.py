@@ -14,6 +14,9 @@ from .materials import polygon_colors
 # Custom property of a baked object: the name of the object it was baked from.
 SOURCE_KEY = "penumbra_source"
 
+# The UV map lightmaps are baked onto (created by the add-on with Lightmap Pack when missing).
+LIGHTMAP_UV = "Lightmap"
+
 # Object types that evaluate to a mesh.
 MESH_TYPES = {"MESH", "CURVE", "SURFACE", "FONT", "META"}
 
@@ -54,7 +57,8 @@ def export_scene(context, settings, objects=None):
     depsgraph = context.evaluated_depsgraph_get()
 
     warnings = []
-    meshes = [_mesh(o, depsgraph, warnings) for o in sources]
+    want_uv = getattr(settings, "output", "MESH") != "MESH"
+    meshes = [_mesh(o, depsgraph, warnings, want_uv) for o in sources]
     light_dicts = []
     for o in lights:
         light_dicts.extend(_light(o, depsgraph))
@@ -83,7 +87,7 @@ def _sources(objects):
     return out
 
 
-def _mesh(obj, depsgraph, warnings):
+def _mesh(obj, depsgraph, warnings, want_uv=False):
     obj_eval = obj.evaluated_get(depsgraph)
     mesh = obj_eval.to_mesh()
     try:
@@ -108,10 +112,11 @@ def _mesh(obj, depsgraph, warnings):
         mesh.polygons.foreach_get("loop_total", counts)
         loop_vert = np.empty(len(mesh.loops), dtype=np.int64)
         mesh.loops.foreach_get("vertex_index", loop_vert)
-        polygon_vertices = loop_vert[_loop_order(starts, counts, np.linalg.det(m[:3, :3]) < 0.0)]
+        order = _loop_order(starts, counts, np.linalg.det(m[:3, :3]) < 0.0)
+        polygon_vertices = loop_vert[order]
 
         albedo, emission = polygon_colors(obj_eval, mesh, warnings)
-        return {
+        out = {
             "name": obj.name,
             "positions": positions,
             "polygon_vertices": polygon_vertices,
@@ -119,8 +124,24 @@ def _mesh(obj, depsgraph, warnings):
             "albedo": np.asarray(albedo, dtype=np.float64).reshape(-1, 3),
             "emission": np.asarray(emission, dtype=np.float64).reshape(-1, 3),
         }
+        if want_uv:
+            out["uv"] = _lightmap_uv(obj, mesh, order)
+        return out
     finally:
         obj_eval.to_mesh_clear()
+
+
+def _lightmap_uv(obj, mesh, order):
+    """The "Lightmap" UV of each polygon corner, in the order of ``polygon_vertices``."""
+    layer = mesh.uv_layers.get(LIGHTMAP_UV)
+    if layer is None:
+        raise ExportError('Object "%s": UV map "%s": missing (a modifier removed it?)' % (obj.name, LIGHTMAP_UV))
+    uv = np.empty(2 * len(mesh.loops), dtype=np.float32)
+    if hasattr(layer, "uv"):  # Blender >= 3.5
+        layer.uv.foreach_get("vector", uv)
+    else:
+        layer.data.foreach_get("uv", uv)
+    return uv.reshape(-1, 2).astype(np.float64)[order]
 
 
 def _loop_order(starts, counts, mirrored):

@@ -9,8 +9,8 @@ import time
 
 import bpy
 
-from . import _core
-from .export import ExportError, export_scene
+from . import _core, lightmap_preview, lightmaps
+from .export import ExportError, _sources, export_scene
 from .import_ import import_bake
 
 # Words of the core's stage names ("shadow volumes", "discontinuity loops", "meshing", ...)
@@ -19,15 +19,39 @@ STAGES = ("validate", "shadow", "loop", "mesh", "direct", "indirect", "output")
 
 
 def prepare(context, report):
-    """The exported scene, or None after reporting why there is nothing sane to bake."""
+    """The exported scene, or None after reporting why there is nothing sane to bake.
+
+    For lightmaps, the objects get their "Lightmap" UV map first (made only where missing;
+    ``export.uv_maps`` remembers those, to take them out again if the bake does not finish)
+    and the UVs are checked before any time goes into the bake."""
+    settings = context.scene.penumbra
+    uv_maps = lightmaps.UvMaps()
     try:
-        return export_scene(context, context.scene.penumbra)
-    except ExportError as e:
-        report({"ERROR"}, str(e))
+        if settings.output != "MESH":
+            uv_maps = lightmaps.ensure_uv_maps(_sources(list(context.selected_objects)), settings.lightmap_resolution)
+        export = export_scene(context, settings)
+        if settings.output != "MESH":
+            lightmaps.check_uvs(export.scene["meshes"], settings.lightmap_resolution, settings.lightmap_margin)
+        export.uv_maps = uv_maps
+        # What the bake was started for: settings changed while it runs do not apply to it.
+        export.output = settings.output
+        export.lightmap = (int(settings.lightmap_resolution), int(settings.lightmap_margin))
+        return export
+    except (ExportError, _core.BakeError) as e:
+        uv_maps.undo()
+        report({"ERROR"}, ("Penumbra: %s" % e) if isinstance(e, _core.BakeError) else str(e))
         return None
-    except Exception as e:  # noqa: BLE001 - a report, never a traceback; nothing changed yet
+    except Exception as e:  # noqa: BLE001 - a report, never a traceback; nothing changed
+        uv_maps.undo()
         report({"ERROR"}, "Penumbra: could not read the scene: %s: %s" % (type(e).__name__, e))
         return None
+
+
+def abandon(export):
+    """A bake that did not finish leaves the scene as it was."""
+    uv_maps = getattr(export, "uv_maps", None)
+    if uv_maps is not None:
+        uv_maps.undo()
 
 
 def finish(context, export, result, seconds, report):
@@ -38,20 +62,49 @@ def finish(context, export, result, seconds, report):
             sources.append(bpy.data.objects.get(obj.name))
         except ReferenceError:  # deleted while the bake ran
             sources.append(None)
-    pairs = [(m, s) for m, s in zip(result["meshes"], sources) if s is not None]
+    kept = [i for i, s in enumerate(sources) if s is not None]
+    pairs = [(result["meshes"][i], sources[i]) for i in kept]
     settings = context.scene.penumbra
-    created = import_bake(context, {"meshes": [m for m, _ in pairs]}, [s for _, s in pairs], settings.hide_originals)
+    output = getattr(export, "output", "MESH")
+    resolution, margin = getattr(export, "lightmap", (0, 0))
+    maps = []
+    if output != "MESH":
+        # Every lightmap is computed before anything is created: an error changes nothing.
+        try:
+            maps = lightmaps.compute(
+                [export.scene["meshes"][i] for i in kept],
+                [m for m, _ in pairs],
+                resolution,
+                margin,
+            )
+        except _core.BakeError as e:
+            abandon(export)
+            report({"ERROR"}, "Penumbra: %s" % e)
+            return {"CANCELLED"}
+    created = []
+    if output != "LIGHTMAP":
+        created = import_bake(
+            context, {"meshes": [m for m, _ in pairs]}, [s for _, s in pairs], settings.hide_originals
+        )
+    images = lightmaps.store(maps)
+    if settings.lightmap_preview:
+        for (_, source), image in zip(pairs, images):
+            lightmap_preview.apply(source, image, settings.lighting_only)
 
     stats = result["stats"]
     elements = stats.get("N_e") or sum(len(m["triangles"]) for m in result["meshes"])
     vertices = stats.get("N_v") or sum(len(m["positions"]) for m in result["meshes"])
+    n = len(created) if output != "LIGHTMAP" else len(images)
     summary = "Penumbra: baked %d object%s, %d elements, %d vertices in %.2f s" % (
-        len(created),
-        "" if len(created) == 1 else "s",
+        n,
+        "" if n == 1 else "s",
         elements,
         vertices,
         seconds,
     )
+    if images:
+        r = resolution
+        summary += ", %d lightmap%s %d×%d" % (len(images), "" if len(images) == 1 else "s", r, r)
     warnings = list(export.warnings) + list(result["warnings"])
     if warnings:
         summary += " (%d warning%s, see console)" % (len(warnings), "" if len(warnings) == 1 else "s")
@@ -59,6 +112,7 @@ def finish(context, export, result, seconds, report):
             print("Penumbra warning:", w)
     settings.last_summary = summary
     settings.last_stats = json.dumps(dict(stats, seconds=seconds))
+    settings.last_outputs = json.dumps({"objects": [o.name for o in created], "images": [i.name for i in images]})
     report({"INFO"}, summary)
     return {"FINISHED"}
 
@@ -72,6 +126,7 @@ def bake_blocking(context, report):
     try:
         result = _core.bake(export.scene)
     except _core.BakeError as e:
+        abandon(export)
         report({"ERROR"}, "Penumbra: %s" % e)
         return {"CANCELLED"}
     return finish(context, export, result, time.perf_counter() - t0, report)
@@ -116,6 +171,7 @@ class PENUMBRA_OT_bake(bpy.types.Operator):
         try:
             self._job = _core.start_bake(self._export.scene)
         except _core.BakeError as e:
+            abandon(self._export)
             self.report({"ERROR"}, "Penumbra: %s" % e)
             return {"CANCELLED"}
         self._t0 = time.perf_counter()
@@ -130,6 +186,7 @@ class PENUMBRA_OT_bake(bpy.types.Operator):
         if event.type == "ESC" and event.value == "PRESS":
             self._job.cancel()
             self._end(context)
+            abandon(self._export)
             self.report({"WARNING"}, "Penumbra: bake cancelled, nothing changed")
             return {"CANCELLED"}
         if event.type != "TIMER":
@@ -147,6 +204,7 @@ class PENUMBRA_OT_bake(bpy.types.Operator):
         try:
             result = self._job.result()
         except _core.BakeError as e:
+            abandon(self._export)
             self.report({"ERROR"}, "Penumbra: %s" % e)
             return {"CANCELLED"}
         return finish(context, self._export, result, time.perf_counter() - self._t0, self.report)

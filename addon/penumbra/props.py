@@ -1,7 +1,7 @@
 """Bake settings, stored on the scene (``scene.penumbra``)."""
 
 import bpy
-from bpy.props import BoolProperty, EnumProperty, FloatProperty, PointerProperty, StringProperty
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 
 # Element edge lengths as fractions of the scene's bounding-box diagonal: (outside penumbra,
 # inside penumbra). Medium's outside size is the core's own default; its penumbra size is
@@ -70,9 +70,45 @@ class PenumbraSettings(bpy.types.PropertyGroup):
         description="Hide the source objects after the bake, in the viewport and in renders",
         default=False,
     )
+    output: EnumProperty(
+        name="Output",
+        description="What a bake makes",
+        items=(
+            ("MESH", "Mesh", "New objects whose meshes follow the shadow boundaries, with the light as colours"),
+            ("LIGHTMAP", "Lightmap", "An image per object on its \"Lightmap\" UV map (for game engines); no new objects"),
+            ("BOTH", "Both", "The new objects and the lightmap images"),
+        ),
+        default="MESH",
+    )
+    # No hard limits: a value out of range reaches the core, which reports it in one line
+    # and changes nothing (a hard limit would silently clamp it).
+    lightmap_resolution: IntProperty(
+        name="Resolution",
+        description="Texels on a side of each object's lightmap (1 to 16384)",
+        default=512,
+        soft_min=16,
+        soft_max=8192,
+    )
+    lightmap_margin: IntProperty(
+        name="Margin",
+        description="Rings of texels filled around the UV islands, so filtering does not bleed in black",
+        default=16,
+        soft_min=0,
+        soft_max=64,
+    )
+    lightmap_preview: BoolProperty(
+        name="Preview on Originals",
+        description=(
+            "Show the lightmap on the original objects' materials: base colour × lightmap with "
+            "Lighting Only, else the lightmap as emission"
+        ),
+        default=False,
+    )
     # Written by the last successful bake, read by the panel and by scripts.
     last_summary: StringProperty(name="Last Bake", default="")
     last_stats: StringProperty(name="Last Bake Stats (JSON)", default="")
+    # What the last successful bake made: {"objects": [names], "images": [names]} (JSON).
+    last_outputs: StringProperty(name="Last Bake Outputs (JSON)", default="")
 
 
 def register():

@@ -31,6 +31,13 @@ class PENUMBRA_PT_radiosity(bpy.types.Panel):
         layout.prop(s, "lighting_only")
         layout.prop(s, "hide_originals")
 
+        layout.prop(s, "output")
+        col = layout.column()
+        col.enabled = s.output != "MESH"
+        col.prop(s, "lightmap_resolution")
+        col.prop(s, "lightmap_margin")
+        col.prop(s, "lightmap_preview")
+
         layout.separator()
         layout.operator("penumbra.bake", icon="LIGHT_AREA")
         if s.last_summary:

@@ -37,6 +37,16 @@ enum Command {
         /// Worker threads (default: all cores).
         #[arg(long)]
         threads: Option<u32>,
+        /// Also rasterise each mesh that has `uv` into a RES×RES lightmap
+        /// (`<name>_radiosity.exr`, float RGB, linear); overrides settings.lightmap_resolution.
+        #[arg(long, value_name = "RES")]
+        lightmap: Option<i64>,
+        /// Rings of texels filled around the UV islands (default 16).
+        #[arg(long)]
+        margin: Option<i64>,
+        /// Where lightmaps go (default: beside the output file).
+        #[arg(long, value_name = "DIR")]
+        lightmap_dir: Option<PathBuf>,
     },
     /// Check SCENE and report problems without baking.
     Validate { scene: PathBuf },
@@ -130,14 +140,29 @@ fn run(cli: Cli) -> ExitCode {
             output,
             stats,
             threads,
+            lightmap,
+            margin,
+            lightmap_dir,
         } => {
             let text = match read(&scene) {
                 Ok(t) => t,
                 Err(e) => return fail(2, e),
             };
-            let mut sc = match penumbra::SceneJson::from_str(&text)
-                .and_then(|j| penumbra::scene::validate(&j))
-            {
+            let mut json = match penumbra::SceneJson::from_str(&text) {
+                Ok(j) => j,
+                Err(e) => return fail(2, e),
+            };
+            if lightmap.is_some() {
+                json.settings.lightmap_resolution = lightmap;
+            }
+            if margin.is_some() {
+                json.settings.lightmap_margin = margin;
+            }
+            // Bad lightmap settings or UVs fail before the bake, not after it.
+            if let Err(e) = check_lightmaps(&json) {
+                return fail(2, e);
+            }
+            let mut sc = match penumbra::scene::validate(&json) {
                 Ok(s) => s,
                 Err(e) => return fail(2, e),
             };
@@ -181,9 +206,62 @@ fn run(cli: Cli) -> ExitCode {
             if stats {
                 eprint!("{}", penumbra::bake::stats_table(&bake.stats));
             }
-            ExitCode::SUCCESS
+            let dir = lightmap_dir
+                .unwrap_or_else(|| output.parent().map(|p| p.to_path_buf()).unwrap_or_default());
+            write_lightmaps(&json, &bake, &dir)
         }
     }
+}
+
+fn check_lightmaps(json: &penumbra::SceneJson) -> Result<(), BakeError> {
+    if penumbra::lightmap::LightmapSettings::from_json(&json.settings)?.is_none() {
+        return Ok(());
+    }
+    for (mi, m) in json.meshes.iter().enumerate() {
+        let Some(uvs) = &m.uv else { continue };
+        let obj = format!("mesh {:?} (meshes[{mi}])", m.name);
+        let (starts, corners) = penumbra::lightmap::flat_polygons(&m.polygons, m.positions.len())
+            .map_err(|(k, i)| {
+            BakeError::invalid(
+                &obj,
+                format!("polygons[{k}]"),
+                format!("index {i} is out of range"),
+            )
+        })?;
+        let layout = penumbra::lightmap::UvLayout {
+            positions: &m.positions,
+            starts: &starts,
+            corners: &corners,
+            uvs,
+        };
+        penumbra::lightmap::check_uv(&obj, &layout)?;
+    }
+    Ok(())
+}
+
+fn write_lightmaps(
+    json: &penumbra::SceneJson,
+    bake: &penumbra::Bake,
+    dir: &std::path::Path,
+) -> ExitCode {
+    let maps = match penumbra::lightmap::scene_lightmaps(json, bake, &Progress::new()) {
+        Ok(m) => m,
+        Err(e) => return fail(2, e),
+    };
+    if maps.iter().any(Option::is_some) {
+        if let Err(e) = std::fs::create_dir_all(dir) {
+            return fail(1, format!("{}: {e}", dir.display()));
+        }
+    }
+    for (m, lm) in json.meshes.iter().zip(&maps) {
+        if let Some(lm) = lm {
+            let path = penumbra_cli::images::lightmap_path(dir, &m.name);
+            if let Err(e) = penumbra_cli::images::write_exr(&path, lm) {
+                return fail(1, e);
+            }
+        }
+    }
+    ExitCode::SUCCESS
 }
 
 fn spawn_bar(p: Arc<Progress>) -> std::thread::JoinHandle<()> {

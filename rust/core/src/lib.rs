@@ -5,12 +5,13 @@
 //! `mesh` → `direct` → `indirect` → `bake` (output); `geom` is shared geometry and depends on
 //! nothing above it.
 
-// The pipeline, in order (see ARCHITECTURE.md). Public: what the CLI, the binding and the
-// tests use (the input format, the bake and its output, the built-in scenes, the exact direct
-// light and the geometry it rests on); the stages' engines are the crate's own.
+// Public: what the CLI, the binding and the tests use (the input format, the bake and its
+// output, lightmaps, the built-in scenes, the exact direct light and the geometry it rests
+// on); the stages' engines are the crate's own. The order of the pipeline: ARCHITECTURE.md.
 pub mod bake;
 pub mod direct;
 pub(crate) mod indirect;
+pub mod lightmap;
 pub(crate) mod mesh;
 pub mod regions;
 pub mod scene;

@@ -22,6 +22,7 @@ fn mesh(name: &str, polys: Vec<Vec<P>>, albedo: [f64; 3]) -> MeshJson {
         polygons,
         albedo: Some(PerPolygon::Uniform(albedo)),
         emission: None,
+        uv: None,
     }
 }
 

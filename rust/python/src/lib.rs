@@ -5,6 +5,7 @@
 mod bake_result;
 mod error;
 mod job;
+mod lightmap;
 mod scene;
 mod value;
 
@@ -58,6 +59,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(bake, m)?)?;
     m.add_function(wrap_pyfunction!(validate, m)?)?;
     m.add_function(wrap_pyfunction!(scene_json, m)?)?;
+    m.add_function(wrap_pyfunction!(lightmap::lightmap, m)?)?;
+    m.add_function(wrap_pyfunction!(lightmap::check_lightmap_uv, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

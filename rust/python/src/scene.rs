@@ -21,6 +21,7 @@ const MESH_KEYS: &[&str] = &[
     "polygon_counts",
     "albedo",
     "emission",
+    "uv",
 ];
 
 pub fn from_py(scene: &Bound<'_, PyAny>) -> Result<SceneJson, Error> {
@@ -181,6 +182,10 @@ fn mesh(obj: &Bound<'_, PyAny>, index: usize) -> Result<MeshJson, Error> {
         polygons,
         albedo,
         emission,
+        uv: match d.get_item("uv").ok().flatten() {
+            Some(a) if !a.is_none() => Some(uv_rows(&a, &object)?),
+            _ => None,
+        },
     })
 }
 
@@ -196,7 +201,7 @@ fn light(obj: &Bound<'_, PyAny>, index: usize) -> Result<LightJson, Error> {
 }
 
 /// A numeric array of any dtype (lists too) as f64, with its shape.
-fn array_f64(
+pub(crate) fn array_f64(
     obj: &Bound<'_, PyAny>,
     object: &str,
     field: &str,
@@ -236,7 +241,7 @@ fn per_polygon(obj: &Bound<'_, PyAny>, object: &str, field: &str) -> Result<PerP
     }
 }
 
-fn ints(obj: &Bound<'_, PyAny>, object: &str, field: &str) -> Result<Vec<i64>, Error> {
+pub(crate) fn ints(obj: &Bound<'_, PyAny>, object: &str, field: &str) -> Result<Vec<i64>, Error> {
     let a: PyArrayLikeDyn<'_, i64, AllowTypeChange> = obj
         .extract()
         .map_err(|e| invalid(object, field, format!("not an integer array: {e}")))?;
@@ -248,4 +253,18 @@ fn ints(obj: &Bound<'_, PyAny>, object: &str, field: &str) -> Result<Vec<i64>, E
         ));
     }
     Ok(a.as_array().iter().copied().collect())
+}
+
+/// Lightmap UVs, one (u, v) per polygon corner.
+fn uv_rows(obj: &Bound<'_, PyAny>, object: &str) -> Result<Vec<[f64; 2]>, Error> {
+    let (shape, data) = array_f64(obj, object, "uv")?;
+    let empty = data.is_empty() && shape.first() == Some(&0);
+    if !(shape.len() == 2 && shape[1] == 2) && !empty {
+        return Err(invalid(
+            object,
+            "uv",
+            format!("expected shape (L, 2), got {shape:?}"),
+        ));
+    }
+    Ok(data.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
 }

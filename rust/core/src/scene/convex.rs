@@ -8,7 +8,7 @@ use crate::geom::{Frame, Plane};
 
 /// Relative out-of-plane deviation above which a polygon is treated as non-planar and
 /// split into triangles (each exactly planar) rather than flattened.
-const PLANAR_TOL: f64 = 1e-7;
+pub(crate) const PLANAR_TOL: f64 = 1e-7;
 
 /// Convex pieces of `pts`, each counter-clockwise around the same side as the input.
 /// Empty when the polygon has no area.
@@ -53,7 +53,7 @@ pub fn convex_pieces(pts: &[DVec3]) -> Vec<Vec<DVec3>> {
 }
 
 /// Convex and counter-clockwise (collinear runs allowed).
-fn is_convex(p: &[DVec2]) -> bool {
+pub(crate) fn is_convex(p: &[DVec2]) -> bool {
     let n = p.len();
     if signed_area_2d(p) <= 0.0 {
         return false;
@@ -64,7 +64,7 @@ fn is_convex(p: &[DVec2]) -> bool {
 /// Ear clipping with exact orientation tests. Works for simple polygons of either winding
 /// (the output keeps the input's winding); for self-intersecting input it still returns
 /// triangles covering the polygon's vertices without panicking.
-fn ear_clip(p: &[DVec2]) -> Vec<[usize; 3]> {
+pub(crate) fn ear_clip(p: &[DVec2]) -> Vec<[usize; 3]> {
     let mut idx: Vec<usize> = (0..p.len()).collect();
     let ccw = signed_area_2d(p) >= 0.0;
     let sign = if ccw { 1.0 } else { -1.0 };

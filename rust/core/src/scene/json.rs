@@ -37,6 +37,9 @@ pub struct MeshJson {
     pub albedo: Option<PerPolygon>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub emission: Option<PerPolygon>,
+    /// Lightmap UVs, one per polygon corner (polygons flattened in order), as Blender's loops.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub uv: Option<Vec<[f64; 2]>>,
 }
 
 /// A light: exactly one of `polygon` (area light, with `radiance`), `point` (with
@@ -111,6 +114,12 @@ pub struct SettingsJson {
     pub visibility_rays: Option<u32>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub threads: Option<u32>,
+    /// Texels on a side of each lightmap; lightmaps are made for meshes with `uv` when set.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lightmap_resolution: Option<i64>,
+    /// Rings of texels filled around the UV islands (default 16).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lightmap_margin: Option<i64>,
 }
 
 impl SceneJson {

@@ -148,6 +148,7 @@ mod test {
             polygons: quads.iter().map(|q| q.to_vec()).collect(),
             albedo: None,
             emission: None,
+            uv: None,
         }
     }
 

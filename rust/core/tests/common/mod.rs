@@ -34,6 +34,7 @@ pub fn mesh(name: &str, polys: Vec<Vec<[f64; 3]>>) -> MeshJson {
         polygons,
         albedo: None,
         emission: None,
+        uv: None,
     }
 }
 
