@@ -4,6 +4,7 @@
 pub mod convex;
 pub mod json;
 pub mod solids;
+pub mod strict;
 pub mod validate;
 
 use glam::{DVec2, DVec3};
