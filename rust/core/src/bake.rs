@@ -202,6 +202,7 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
     }
     let radiance = colors(scene, &elements, &irradiance);
     let out = output(scene, &elements, &radiance);
+    crate::coverage::check(scene, &out)?;
     stats.T_total = t_start.elapsed().as_secs_f64();
     Ok(Bake {
         format: "penumbra-bake",

@@ -7,6 +7,7 @@
 pub mod arrangement;
 pub mod bake;
 pub mod buried;
+pub mod coverage;
 pub mod covered;
 pub mod cuts;
 pub mod direct;

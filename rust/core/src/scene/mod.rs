@@ -3,6 +3,7 @@
 
 pub mod convex;
 pub mod json;
+pub mod precision;
 pub mod reach;
 pub mod solids;
 pub mod strict;

@@ -1,0 +1,126 @@
+//! The last check of every bake: each input polygon's output triangles cover its area, lie
+//! in it and face its way. A bake that lost or moved geometry (a scene past the precision
+//! contract of `precision`, or a bug) ends in an error naming the polygon instead of a
+//! result that silently misses a floor.
+//!
+//! The check is on the output itself (after welding), so it sees what the user would get.
+//! It is linear in the output: each triangle is compared with the convex pieces of its own
+//! source polygon only.
+
+use glam::DVec3;
+
+use crate::bake::BakedMesh;
+use crate::geom::polygon::signed_area_2d;
+use crate::scene::{Face, Scene};
+use crate::BakeError;
+
+/// Output area may differ from the input area by this fraction (the mesher snaps corners by
+/// ~1e-9 of a receiver, and the weld merges vertices within 1e-9 of the scene), and a vertex
+/// may lie this fraction of its polygon's size outside it.
+pub const AREA_TOLERANCE: f64 = 1e-5;
+pub const DISTANCE_TOLERANCE: f64 = 1e-6;
+
+/// Checks `out` (one `BakedMesh` per scene mesh, same order) against the scene's polygons.
+pub fn check(scene: &Scene, out: &[BakedMesh]) -> Result<(), BakeError> {
+    let weld = 1e-9 * scene.diagonal();
+    for (mi, (info, baked)) in scene.meshes.iter().zip(out).enumerate() {
+        let obj = format!("mesh {:?} (meshes[{mi}])", info.name);
+        let faces = &scene.faces[info.face_start..info.face_end];
+        // Convex pieces of each source polygon (validate keeps a polygon's pieces together).
+        let mut pieces: Vec<Vec<&Face>> = vec![Vec::new(); info.n_polygons];
+        for f in faces {
+            pieces[f.source_polygon as usize].push(f);
+        }
+        let mut covered = vec![0.0f64; info.n_polygons];
+        for (t, tri) in baked.triangles.iter().enumerate() {
+            let p = baked.source_polygon[t] as usize;
+            let Some(own) = pieces.get(p).filter(|v| !v.is_empty()) else {
+                return Err(BakeError::invalid(
+                    &obj,
+                    format!("polygons[{p}]"),
+                    "the bake made triangles for a polygon that has none (internal error)",
+                ));
+            };
+            let v = tri.map(|i| DVec3::from_array(baked.positions[i as usize]));
+            let n = own[0].plane.n;
+            let signed = 0.5 * (v[1] - v[0]).cross(v[2] - v[0]).dot(n);
+            let size = extent(own);
+            let tol = DISTANCE_TOLERANCE * size + 4.0 * weld;
+            if signed < -(tol * tol) {
+                return Err(lost(&obj, p, "a triangle of the bake faces the other way"));
+            }
+            covered[p] += signed;
+            for q in v {
+                if !own.iter().any(|f| inside(f, q, tol)) {
+                    return Err(lost(
+                        &obj,
+                        p,
+                        &format!(
+                            "a triangle of the bake has a corner {} outside the polygon",
+                            show(q)
+                        ),
+                    ));
+                }
+            }
+        }
+        for (p, own) in pieces.iter().enumerate() {
+            if own.is_empty() {
+                continue; // degenerate, dropped with a warning by `validate`
+            }
+            let area: f64 = own.iter().map(|f| f.area).sum();
+            let tol = AREA_TOLERANCE * area + 4.0 * weld * extent(own);
+            if (covered[p] - area).abs() > tol {
+                return Err(lost(
+                    &obj,
+                    p,
+                    &format!(
+                        "the bake covers {:.6}% of its area",
+                        100.0 * covered[p] / area
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+fn lost(obj: &str, p: usize, what: &str) -> BakeError {
+    BakeError::invalid(
+        obj,
+        format!("polygons[{p}]"),
+        format!(
+            "{what}: geometry lost to floating-point precision (see the README's precision contract)"
+        ),
+    )
+}
+
+fn show(q: DVec3) -> String {
+    format!("({:e}, {:e}, {:e})", q.x, q.y, q.z)
+}
+
+/// The largest extent of a polygon's pieces.
+fn extent(pieces: &[&Face]) -> f64 {
+    pieces.iter().map(|f| f.extent(0.0)).fold(0.0, f64::max)
+}
+
+/// `q` within `tol` of the convex face (its plane, and its 2-D outline).
+fn inside(f: &Face, q: DVec3, tol: f64) -> bool {
+    if f.plane.dist(q).abs() > tol {
+        return false;
+    }
+    let p = f.frame.to_2d(q);
+    let ccw = signed_area_2d(&f.poly2) >= 0.0;
+    let n = f.poly2.len();
+    (0..n).all(|i| {
+        let (a, b) = (f.poly2[i], f.poly2[(i + 1) % n]);
+        let e = b - a;
+        let len = e.length();
+        if len == 0.0 {
+            return true;
+        }
+        // Signed distance to the left of a→b (inside for a counter-clockwise outline).
+        let left = e.perp_dot(p - a) / len;
+        let left = if ccw { left } else { -left };
+        left >= -tol
+    })
+}
