@@ -124,3 +124,75 @@ fn inside(f: &Face, q: DVec3, tol: f64) -> bool {
         left >= -tol
     })
 }
+
+#[cfg(test)]
+mod test {
+    use super::*;
+    use crate::scene::json::SceneJson;
+
+    /// A floor (two polygons) under a square light, baked.
+    fn baked() -> (Scene, Vec<BakedMesh>) {
+        let text = r#"{"format":"penumbra-scene","version":1,
+          "meshes":[{"name":"Floor","positions":[[-1,-1,0],[0,-1,0],[0,1,0],[-1,1,0],[1,-1,0],[1,1,0]],
+                     "polygons":[[0,1,2,3],[1,4,5,2]]},
+                    {"name":"Occ","positions":[[-0.2,-0.2,0.5],[0.2,-0.2,0.5],[0.2,0.2,0.5],[-0.2,0.2,0.5]],
+                     "polygons":[[0,1,2,3]]}],
+          "lights":[{"name":"L","polygon":[[-0.3,-0.3,2],[-0.3,0.3,2],[0.3,0.3,2],[0.3,-0.3,2]],"radiance":[1,1,1]}],
+          "settings":{"indirect":false}}"#;
+        let scene = crate::scene::validate(&SceneJson::from_str(text).unwrap()).unwrap();
+        let bake = crate::bake(&scene, &crate::Progress::new()).unwrap();
+        (scene, bake.meshes)
+    }
+
+    #[test]
+    fn a_real_bake_passes() {
+        let (scene, out) = baked();
+        check(&scene, &out).unwrap();
+    }
+
+    #[test]
+    fn a_missing_triangle_is_named() {
+        let (scene, mut out) = baked();
+        let t = out[0].source_polygon.iter().position(|&p| p == 1).unwrap();
+        out[0].triangles.remove(t);
+        out[0].source_polygon.remove(t);
+        let e = check(&scene, &out).unwrap_err().to_string();
+        assert!(
+            e.starts_with(r#"mesh "Floor" (meshes[0]): polygons[1]: the bake covers"#),
+            "{e}"
+        );
+        assert!(e.contains("geometry lost"), "{e}");
+    }
+
+    #[test]
+    fn a_corner_outside_its_polygon_is_named() {
+        let (scene, mut out) = baked();
+        // Shift one polygon-0 triangle (x in [-1, 0]) by 1.5 along x, onto polygon 1.
+        let t = out[0].source_polygon.iter().position(|&p| p == 0).unwrap();
+        for k in 0..3 {
+            let mut q = out[0].positions[out[0].triangles[t][k] as usize];
+            q[0] += 1.5;
+            out[0].positions.push(q);
+            out[0].triangles[t][k] = (out[0].positions.len() - 1) as u32;
+        }
+        let e = check(&scene, &out).unwrap_err().to_string();
+        assert!(
+            e.contains("polygons[0]") && e.contains("outside the polygon"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_flipped_triangle_is_named() {
+        let (scene, mut out) = baked();
+        let t = out[1].triangles.len() / 2;
+        out[1].triangles[t].swap(1, 2);
+        let e = check(&scene, &out).unwrap_err().to_string();
+        assert!(
+            e.starts_with(
+                r#"mesh "Occ" (meshes[1]): polygons[0]: a triangle of the bake faces the other way"#
+            ),
+            "{e}"
+        );
+    }
+}
