@@ -133,14 +133,18 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
     progress.check()?;
     let t = Instant::now();
     let diag = scene.diagonal();
+    // `None` once cancelled: rayon stops handing out receivers.
     let built: Vec<(ReceiverRegions, RegionTimes)> = scene
         .faces
         .par_iter()
         .zip(&shadows)
         .map(|(f, sh)| {
-            regions::build_regions(f, sh, diag, scene.settings.uniform, scene.settings.indirect)
+            (!progress.is_cancelled()).then(|| {
+                regions::build_regions(f, sh, diag, scene.settings.uniform, scene.settings.indirect)
+            })
         })
-        .collect();
+        .collect::<Option<_>>()
+        .ok_or(BakeError::Cancelled)?;
     // Stage times are wall time, split between sub-stages by their share of CPU time.
     let wall = t.elapsed().as_secs_f64();
     let parts = built.iter().fold([0.0; 4], |a, (_, t)| {
@@ -171,7 +175,7 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
         .map(|((rr, sh), f)| {
             progress.check()?;
             let sizing = Sizing::new(f, &scene.lights, &scene.settings);
-            mesh::mesh_receiver(rr, sh, &sizing, &scene.settings, diag, &budget)
+            mesh::mesh_receiver(rr, sh, &sizing, &scene.settings, diag, &budget, progress)
         })
         .collect::<Result<_, _>>()?;
     let elements = assemble(scene, &meshes);

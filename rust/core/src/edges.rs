@@ -202,7 +202,7 @@ pub fn shadow_polygons(
             .par_iter()
             .enumerate()
             .map(|(oi, o)| {
-                if buried.occluders[oi] {
+                if buried.occluders[oi] || progress.is_cancelled() {
                     return Vec::new();
                 }
                 occluder_volumes(&light.kind, None, oi as u32, o, faces, eps)
@@ -255,7 +255,8 @@ pub fn shadow_polygons(
             .par_iter()
             .enumerate()
             .map(|(ri, r)| {
-                if buried.faces[ri] {
+                // A cancelled bake skips the rest of the receivers (checked after the loop).
+                if buried.faces[ri] || progress.is_cancelled() {
                     return OnReceiver::hidden();
                 }
                 receiver_polygons(
@@ -270,6 +271,7 @@ pub fn shadow_polygons(
                 )
             })
             .collect();
+        progress.check()?;
         for (ri, res) in results.into_iter().enumerate() {
             per_receiver[ri].exposure[li] = res.exposure;
             per_receiver[ri].polys.extend(res.polys);
@@ -298,11 +300,15 @@ pub fn shadow_polygons(
     }
     let t2 = std::time::Instant::now();
     per_receiver.par_iter_mut().zip(faces).for_each(|(r, f)| {
+        if progress.is_cancelled() {
+            return;
+        }
         crate::umbra_cover::drop_covered(&mut r.polys, &r.inside);
         let snap = 1e-9 * f.extent(scene.diagonal());
         crate::umbra_cover::trim_lines(r, snap, !scene.settings.indirect);
     });
     stats.t_isr += t2.elapsed().as_secs_f64();
+    progress.check()?;
     Ok((per_receiver, stats))
 }
 

@@ -18,6 +18,7 @@ pub mod events;
 pub mod geom;
 pub mod indirect;
 pub mod mesh;
+pub mod mesh_cancel;
 pub mod patches;
 pub mod progress;
 pub mod regions;

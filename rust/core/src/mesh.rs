@@ -49,6 +49,7 @@ pub fn mesh_receiver(
     settings: &Settings,
     diag: f64,
     budget: &AtomicU64,
+    progress: &crate::Progress,
 ) -> Result<ReceiverMesh, BakeError> {
     let arr = &rr.arrangement;
     let mut cdt = Cdt::new();
@@ -62,7 +63,10 @@ pub fn mesh_receiver(
         handle.insert(v, h);
         Some(h)
     };
-    for &e in &rr.kept_edges {
+    for (k, &e) in rr.kept_edges.iter().enumerate() {
+        if k % 1024 == 0 {
+            progress.check()?;
+        }
         let [a, b] = arr.edges[e as usize].v;
         let (Some(ha), Some(hb)) = (vh(&mut cdt, a), vh(&mut cdt, b)) else {
             continue;
@@ -78,6 +82,7 @@ pub fn mesh_receiver(
     let corners = Corners::new(sh, coarse);
     let mut seeds = Vec::new();
     for (f, rf) in arr.faces.iter().zip(&rr.faces) {
+        progress.check()?;
         let penumbra = !settings.uniform && rf.relations.iter().any(|r| *r == Relation::Penumbra);
         let seen = |l: usize| rf.relations.get(l).is_some_and(|r| *r != Relation::Umbra);
         let size = |p: DVec2, reach: f64| {
@@ -101,9 +106,13 @@ pub fn mesh_receiver(
             ),
         ));
     }
-    for p in seeds {
+    for (k, p) in seeds.into_iter().enumerate() {
+        if k % 4096 == 0 {
+            progress.check()?;
+        }
         let _ = cdt.insert(Point2::new(p.x, p.y));
     }
+    progress.check()?;
     let coarse_area = 0.433 * coarse * coarse;
     let fine = sizing
         .smallest()
@@ -112,13 +121,15 @@ pub fn mesh_receiver(
     let fine_area = 0.433 * fine * fine;
     let extra =
         (settings.max_elements.saturating_sub(used) as usize).min(cdt.num_vertices() * 4 + 64);
-    cdt.refine(
+    crate::mesh_cancel::refine_in_rounds(
+        &mut cdt,
         RefinementParameters::new()
             .with_angle_limit(AngleLimit::from_deg(settings.min_angle))
             .with_max_allowed_area(coarse_area * 1.5)
-            .with_min_required_area(fine_area * 0.02)
-            .with_max_additional_vertices(extra),
-    );
+            .with_min_required_area(fine_area * 0.02),
+        extra,
+        progress,
+    )?;
     budget.fetch_add(
         cdt.num_vertices() as u64 - handle.len() as u64,
         Ordering::Relaxed,
@@ -131,6 +142,7 @@ pub fn mesh_receiver(
         })];
         return Ok(m);
     }
+    progress.check()?;
     Ok(extract(&cdt, sh, sizing.frame(), false, diag))
 }
 
