@@ -27,10 +27,17 @@ pub fn check(scene: &Scene, out: &[BakedMesh]) -> Result<(), BakeError> {
         let obj = format!("mesh {:?} (meshes[{mi}])", info.name);
         let faces = &scene.faces[info.face_start..info.face_end];
         // Convex pieces of each source polygon (validate keeps a polygon's pieces together).
-        let mut pieces: Vec<Vec<&Face>> = vec![Vec::new(); info.n_polygons];
-        for f in faces {
-            pieces[f.source_polygon as usize].push(f);
+        let mut pieces: Vec<Vec<usize>> = vec![Vec::new(); info.n_polygons];
+        for (i, f) in faces.iter().enumerate() {
+            pieces[f.source_polygon as usize].push(i);
         }
+        // Sizes and windings once per polygon and face, not per corner (a 1,000-gon's
+        // outline would otherwise be walked three times per triangle).
+        let sizes: Vec<f64> = pieces.iter().map(|own| extent(faces, own)).collect();
+        let ccw: Vec<bool> = faces
+            .iter()
+            .map(|f| signed_area_2d(&f.poly2) >= 0.0)
+            .collect();
         let mut covered = vec![0.0f64; info.n_polygons];
         for (t, tri) in baked.triangles.iter().enumerate() {
             let p = baked.source_polygon[t] as usize;
@@ -42,16 +49,15 @@ pub fn check(scene: &Scene, out: &[BakedMesh]) -> Result<(), BakeError> {
                 ));
             };
             let v = tri.map(|i| DVec3::from_array(baked.positions[i as usize]));
-            let n = own[0].plane.n;
+            let n = faces[own[0]].plane.n;
             let signed = 0.5 * (v[1] - v[0]).cross(v[2] - v[0]).dot(n);
-            let size = extent(own);
-            let tol = DISTANCE_TOLERANCE * size + 4.0 * weld;
+            let tol = DISTANCE_TOLERANCE * sizes[p] + 4.0 * weld;
             if signed < -(tol * tol) {
                 return Err(lost(&obj, p, "a triangle of the bake faces the other way"));
             }
             covered[p] += signed;
             for q in v {
-                if !own.iter().any(|f| inside(f, q, tol)) {
+                if !own.iter().any(|&i| inside(&faces[i], ccw[i], q, tol)) {
                     return Err(lost(
                         &obj,
                         p,
@@ -67,8 +73,8 @@ pub fn check(scene: &Scene, out: &[BakedMesh]) -> Result<(), BakeError> {
             if own.is_empty() {
                 continue; // degenerate, dropped with a warning by `validate`
             }
-            let area: f64 = own.iter().map(|f| f.area).sum();
-            let tol = AREA_TOLERANCE * area + 4.0 * weld * extent(own);
+            let area: f64 = own.iter().map(|&i| faces[i].area).sum();
+            let tol = AREA_TOLERANCE * area + 4.0 * weld * sizes[p];
             if (covered[p] - area).abs() > tol {
                 return Err(lost(
                     &obj,
@@ -99,30 +105,58 @@ fn show(q: DVec3) -> String {
 }
 
 /// The largest extent of a polygon's pieces.
-fn extent(pieces: &[&Face]) -> f64 {
-    pieces.iter().map(|f| f.extent(0.0)).fold(0.0, f64::max)
+fn extent(faces: &[Face], pieces: &[usize]) -> f64 {
+    pieces
+        .iter()
+        .map(|&i| faces[i].extent(0.0))
+        .fold(0.0, f64::max)
 }
 
 /// `q` within `tol` of the convex face (its plane, and its 2-D outline).
-fn inside(f: &Face, q: DVec3, tol: f64) -> bool {
+fn inside(f: &Face, ccw: bool, q: DVec3, tol: f64) -> bool {
     if f.plane.dist(q).abs() > tol {
         return false;
     }
     let p = f.frame.to_2d(q);
-    let ccw = signed_area_2d(&f.poly2) >= 0.0;
-    let n = f.poly2.len();
-    (0..n).all(|i| {
-        let (a, b) = (f.poly2[i], f.poly2[(i + 1) % n]);
+    let poly = &f.poly2;
+    let n = poly.len();
+    // Signed distance of p to the left of edge i (inside for a counter-clockwise outline).
+    let left_of = |i: usize| {
+        let (a, b) = (poly[i], poly[(i + 1) % n]);
         let e = b - a;
         let len = e.length();
         if len == 0.0 {
-            return true;
+            return f64::INFINITY;
         }
-        // Signed distance to the left of a→b (inside for a counter-clockwise outline).
-        let left = e.perp_dot(p - a) / len;
-        let left = if ccw { left } else { -left };
-        left >= -tol
-    })
+        let d = e.perp_dot(p - a) / len;
+        if ccw {
+            d
+        } else {
+            -d
+        }
+    };
+    if n <= 16 || !ccw {
+        return (0..n).all(|i| left_of(i) >= -tol);
+    }
+    // Many edges (a 1,000-gon disk): find the wedge of the fan from vertex 0 that holds p by
+    // bisection, and test the one outline edge that closes it, and the fan's two sides.
+    let side = |i: usize| (poly[i] - poly[0]).perp_dot(p - poly[0]);
+    if side(1) < 0.0 {
+        return left_of(0) >= -tol;
+    }
+    if side(n - 1) > 0.0 {
+        return left_of(n - 1) >= -tol;
+    }
+    let (mut lo, mut hi) = (1usize, n - 1);
+    while hi - lo > 1 {
+        let mid = (lo + hi) / 2;
+        if side(mid) >= 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    left_of(lo) >= -tol
 }
 
 #[cfg(test)]
