@@ -429,3 +429,14 @@ def test_a_light_the_scene_json_cannot_hold_is_refused(room_scene, empty):
     _, light = room_scene
     light.data.use_shadow = False
     _refused(empty, ["Ceiling Light", "use_shadow"])
+
+
+def test_a_light_that_gives_nothing_is_counted_in_the_report(empty):
+    """A light facing away from everything bakes (it is a valid scene), but the report says so."""
+    _cube().select_set(True)
+    _area_light("Lamp")
+    away = _area_light("Away", z=4.0)
+    away.rotation_euler = (math.pi, 0.0, 0.0)  # emits upwards, away from the cube
+    assert bpy.ops.penumbra.bake() == {"FINISHED"}
+    summary = empty.scene.penumbra.last_summary
+    assert "(1 warning, see console)" in summary, summary

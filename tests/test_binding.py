@@ -204,3 +204,64 @@ def test_the_gil_is_released_during_a_blocking_bake():
             counted += 1
     t.join()
     assert counted > 100
+
+
+def test_float_polygon_vertices_are_refused_not_truncated():
+    scene = plane_under_square_light()
+    m = scene["meshes"][0]
+    m["polygon_vertices"] = m["polygon_vertices"].astype(np.float64) + 0.7
+    e = error_of(scene)
+    assert (e.kind, e.field) == ("invalid", "polygon_vertices")
+    assert "Floor" in e.object and "integers" in str(e)
+    m["polygon_vertices"] = np.round(m["polygon_vertices"] - 0.7).astype(np.float32)
+    assert error_of(scene).field == "polygon_vertices"  # even when whole: a float is no index
+    scene = plane_under_square_light()
+    scene["meshes"][0]["polygon_counts"] = [4.0]
+    assert error_of(scene).field == "polygon_counts"
+
+
+def test_unsigned_indices_past_int64_are_reported_as_written():
+    scene = plane_under_square_light()
+    m = scene["meshes"][0]
+    v = m["polygon_vertices"].astype(np.uint64)
+    v[3] = np.uint64(2**64 - 1)
+    m["polygon_vertices"] = v
+    e = error_of(scene)
+    assert e.field == "polygon_vertices[3]"
+    assert "18446744073709551615" in str(e) and "-1" not in str(e)
+    # In range, unsigned indices are fine.
+    m["polygon_vertices"] = plane_under_square_light()["meshes"][0]["polygon_vertices"].astype(np.uint32)
+    assert _core.validate(scene) == []
+
+
+def test_complex_and_boolean_coordinates_are_refused():
+    scene = plane_under_square_light()
+    scene["meshes"][0]["positions"] = scene["meshes"][0]["positions"] + 0j
+    e = error_of(scene)
+    assert (e.field, "complex" in str(e)) == ("positions", True)
+    scene = plane_under_square_light()
+    scene["meshes"][0]["albedo"] = np.ones((1, 3), dtype=bool)
+    assert error_of(scene).field == "albedo"
+    # Integer coordinates are real numbers: accepted.
+    scene = plane_under_square_light()
+    scene["meshes"][0]["positions"] = scene["meshes"][0]["positions"].astype(np.int32)
+    assert _core.validate(scene) == []
+
+
+def test_settings_and_lights_by_position_are_refused():
+    scene = plane_under_square_light()
+    scene["settings"] = [0.05]
+    e = error_of(scene)
+    assert "settings" in str(e) and "got a list" in str(e)
+    scene = plane_under_square_light()
+    scene["lights"] = [["Lamp", scene["lights"][0]["polygon"], [10.0, 10.0, 10.0]]]
+    e = error_of(scene)
+    assert "lights[0]" in str(e) and "got a list" in str(e)
+
+
+def test_format_errors_name_the_path():
+    scene = plane_under_square_light()
+    scene["lights"][0]["radiance"] = [1.0, 1.0]
+    e = error_of(scene)
+    assert (e.kind, e.field) == ("invalid", "radiance")
+    assert "Lamp" in e.object and "line" not in str(e)

@@ -34,8 +34,8 @@ enum Command {
         /// Print the stats table (paper's names) to stderr when done.
         #[arg(long)]
         stats: bool,
-        /// Worker threads (default: all cores).
-        #[arg(long)]
+        /// Worker threads, 1 to 1024 like the `threads` setting (default: all cores).
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=penumbra_cli::args::MAX_THREADS))]
         threads: Option<u32>,
         /// Also rasterise each mesh that has `uv` into a RES×RES lightmap
         /// (`<name>_radiosity.exr`, float RGB, linear); overrides settings.lightmap_resolution.
@@ -89,7 +89,10 @@ fn main() -> ExitCode {
             .unwrap_or_default();
         eprintln!("penumbra: internal error: {msg}{at}");
     }));
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) => return penumbra_cli::args::report(e),
+    };
     match std::panic::catch_unwind(|| run(cli)) {
         Ok(code) => code,
         Err(_) => ExitCode::from(3),
@@ -167,9 +170,6 @@ fn run(cli: Cli) -> ExitCode {
                 Err(e) => return fail(2, e),
             };
             if let Some(t) = threads {
-                if t == 0 {
-                    return fail(2, "--threads: must be at least 1");
-                }
                 sc.settings.threads = Some(t);
             }
             for w in &sc.warnings {
@@ -193,15 +193,17 @@ fn run(cli: Cli) -> ExitCode {
                 .extension()
                 .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
             let written = if output.as_os_str() == "-" {
-                println!("{}", bake.to_json());
-                Ok(())
+                penumbra_cli::args::write_stdout(&bake.to_json())
             } else if glb {
                 std::fs::write(&output, penumbra_cli::gltf::to_glb(&bake))
             } else {
                 std::fs::write(&output, bake.to_json())
             };
-            if let Err(e) = written {
-                return fail(1, format!("{}: {e}", output.display()));
+            match written {
+                Ok(()) => {}
+                // The reader went away (`| head`): nothing more to say, and nobody to say it to.
+                Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => return ExitCode::from(1),
+                Err(e) => return fail(1, format!("{}: {e}", output.display())),
             }
             if stats {
                 eprint!("{}", penumbra::bake::stats_table(&bake.stats));

@@ -177,3 +177,92 @@ fn writes_binary_gltf() {
         bin_len
     );
 }
+
+/// A reader that closes the pipe early (`| head -c 10`) is a write failure: exit 1, and no
+/// "internal error" on stderr.
+#[test]
+fn broken_pipe_on_stdout_is_exit_1_quietly() {
+    use std::process::Stdio;
+    let p = write("pipe.json", GOOD);
+    let mut child = penumbra()
+        .args(["bake", p.to_str().unwrap(), "--output", "-"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Close our end before the bake is written: every write then fails with EPIPE.
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(!err.contains("internal error"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+#[test]
+fn threads_bounded_like_the_setting() {
+    let p = write("threads.json", GOOD);
+    for t in ["0", "1025", "100000", "many"] {
+        let out = penumbra()
+            .args([
+                "bake",
+                p.to_str().unwrap(),
+                "-o",
+                "/dev/null",
+                "--threads",
+                t,
+            ])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "--threads {t}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "--threads {t}: {err}");
+        assert!(err.contains("--threads"), "--threads {t}: {err}");
+        assert!(err.contains("(see --help)"), "--threads {t}: {err}");
+    }
+    let out = penumbra()
+        .args([
+            "bake",
+            p.to_str().unwrap(),
+            "-o",
+            "/dev/null",
+            "--threads",
+            "1024",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// Clap's usage block is replaced by one line naming the problem and pointing at --help.
+#[test]
+fn argument_errors_are_one_line_and_exit_2() {
+    let cases: [&[&str]; 6] = [
+        &[],
+        &["bake"],
+        &["bake", "scene.json"],
+        &["bake", "scene.json", "-o", "x", "--frobnicate"],
+        &["frobnicate"],
+        &["scene", "--output"],
+    ];
+    for args in cases {
+        let out = penumbra().args(args).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        assert!(err.starts_with("penumbra: error: "), "{args:?}: {err}");
+        assert!(err.trim_end().ends_with("(see --help)"), "{args:?}: {err}");
+    }
+    // The missing argument is named, not left to the usage block.
+    let out = penumbra().args(["bake", "scene.json"]).output().unwrap();
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--output"));
+    // Help still prints in full, exit 0.
+    let out = penumbra().arg("--help").output().unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("bake"));
+}

@@ -136,12 +136,17 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
     progress.stage("discontinuity loops");
     progress.check()?;
     let t = Instant::now();
+    // `None` once cancelled: rayon stops handing out receivers.
     let built: Vec<(ReceiverRegions, RegionTimes)> = scene
         .faces
         .par_iter()
         .zip(shadows)
-        .map(|(f, sh)| regions::build_regions(f, sh, &tol, scene.settings.uniform, keep_contacts))
-        .collect();
+        .map(|(f, sh)| {
+            (!progress.is_cancelled())
+                .then(|| regions::build_regions(f, sh, &tol, scene.settings.uniform, keep_contacts))
+        })
+        .collect::<Option<_>>()
+        .ok_or(BakeError::Cancelled)?;
     // Stage times are wall time, split between sub-stages by their share of CPU time.
     let wall = t.elapsed().as_secs_f64();
     let parts = built.iter().fold([0.0; 4], |a, (_, t)| {
@@ -171,7 +176,7 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
         .map(|(rr, f)| {
             progress.check()?;
             let sizing = Sizing::new(f, &scene.lights, &scene.settings);
-            mesh::mesh_receiver(rr, &sizing, &scene.settings, &tol, &budget)
+            mesh::mesh_receiver(rr, &sizing, &scene.settings, &tol, &budget, progress)
         })
         .collect::<Result<_, _>>()?;
     let elements = assemble(scene, &meshes);
@@ -202,6 +207,7 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
     }
     let radiance = colors(scene, &elements, &irradiance);
     let out = output(scene, &tol, &elements, &radiance);
+    crate::mesh::coverage::check(scene, &out)?;
     stats.T_total = t_start.elapsed().as_secs_f64();
     Ok(Bake {
         format: "penumbra-bake",

@@ -69,8 +69,7 @@ pub fn from_py(scene: &Bound<'_, PyAny>) -> Result<SceneJson, Error> {
     let settings = match dict.get_item("settings").ok().flatten() {
         Some(s) if !s.is_none() => {
             let v = to_value(&s, "settings", "")?;
-            serde_json::from_value::<SettingsJson>(v)
-                .map_err(|e| invalid("settings", "", e.to_string()))?
+            penumbra::scene::strict::settings_from_value(&v)?
         }
         _ => SettingsJson::default(),
     };
@@ -197,15 +196,28 @@ fn light(obj: &Bound<'_, PyAny>, index: usize) -> Result<LightJson, Error> {
         .unwrap_or_default();
     let object = format!("light {name:?} (lights[{index}])");
     let v: Value = to_value(obj, &object, "")?;
-    serde_json::from_value::<LightJson>(v).map_err(|e| invalid(&object, "", e.to_string()))
+    Ok(penumbra::scene::strict::light_from_value(&v, index)?)
 }
 
-/// A numeric array of any dtype (lists too) as f64, with its shape.
+/// A real-valued array (lists too) as f64, with its shape. Complex, boolean, string and
+/// object dtypes are refused: numpy would otherwise drop an imaginary part or read `True`
+/// as 1 without a word.
 pub(crate) fn array_f64(
     obj: &Bound<'_, PyAny>,
     object: &str,
     field: &str,
 ) -> Result<(Vec<usize>, Vec<f64>), Error> {
+    let (kind, size) = dtype_kind(obj, object, field)?;
+    if !matches!(kind, 'f' | 'i' | 'u') && size > 0 {
+        return Err(invalid(
+            object,
+            field,
+            format!(
+                "expected real numbers, got dtype kind {kind:?} ({})",
+                kind_name(kind)
+            ),
+        ));
+    }
     let a: PyArrayLikeDyn<'_, f64, AllowTypeChange> = obj
         .extract()
         .map_err(|e| invalid(object, field, format!("not a numeric array: {e}")))?;
@@ -241,18 +253,92 @@ fn per_polygon(obj: &Bound<'_, PyAny>, object: &str, field: &str) -> Result<PerP
     }
 }
 
+/// Indices: an integer dtype only (a float index would be truncated by a cast), and unsigned
+/// values past `i64::MAX` reported as written instead of wrapping to negative numbers.
 pub(crate) fn ints(obj: &Bound<'_, PyAny>, object: &str, field: &str) -> Result<Vec<i64>, Error> {
-    let a: PyArrayLikeDyn<'_, i64, AllowTypeChange> = obj
-        .extract()
-        .map_err(|e| invalid(object, field, format!("not an integer array: {e}")))?;
-    if a.shape().len() != 1 {
-        return Err(invalid(
+    let (kind, size) = dtype_kind(obj, object, field)?;
+    if size == 0 {
+        return Ok(Vec::new()); // `[]` is float64 to numpy; empty is empty
+    }
+    let flat = |shape: &[usize]| {
+        if shape.len() != 1 {
+            return Err(invalid(
+                object,
+                field,
+                format!("expected a flat array, got shape {shape:?}"),
+            ));
+        }
+        Ok(())
+    };
+    match kind {
+        'i' => {
+            let a: PyArrayLikeDyn<'_, i64, AllowTypeChange> = obj
+                .extract()
+                .map_err(|e| invalid(object, field, format!("not an integer array: {e}")))?;
+            flat(a.shape())?;
+            Ok(a.as_array().iter().copied().collect())
+        }
+        'u' => {
+            let a: PyArrayLikeDyn<'_, u64, AllowTypeChange> = obj
+                .extract()
+                .map_err(|e| invalid(object, field, format!("not an integer array: {e}")))?;
+            flat(a.shape())?;
+            a.as_array()
+                .iter()
+                .enumerate()
+                .map(|(k, &u)| {
+                    i64::try_from(u).map_err(|_| {
+                        invalid(
+                            object,
+                            &format!("{field}[{k}]"),
+                            format!("index {u} is out of range"),
+                        )
+                    })
+                })
+                .collect()
+        }
+        _ => Err(invalid(
             object,
             field,
-            format!("expected a flat array, got shape {:?}", a.shape()),
-        ));
+            format!(
+                "expected integers, got dtype kind {kind:?} ({})",
+                kind_name(kind)
+            ),
+        )),
     }
-    Ok(a.as_array().iter().copied().collect())
+}
+
+/// numpy's dtype kind of `obj` as an array (`np.asarray`), and its size.
+fn dtype_kind(obj: &Bound<'_, PyAny>, object: &str, field: &str) -> Result<(char, usize), Error> {
+    let arr = obj
+        .py()
+        .import("numpy")
+        .and_then(|np| np.getattr("asarray"))
+        .and_then(|f| f.call1((obj,)))
+        .map_err(|e| invalid(object, field, format!("not a numeric array: {e}")))?;
+    let kind: String = arr
+        .getattr("dtype")
+        .and_then(|d| d.getattr("kind"))
+        .and_then(|k| k.extract())
+        .map_err(|e| invalid(object, field, format!("not a numeric array: {e}")))?;
+    let size: usize = arr
+        .getattr("size")
+        .and_then(|s| s.extract())
+        .map_err(|e| invalid(object, field, format!("not a numeric array: {e}")))?;
+    Ok((kind.chars().next().unwrap_or('?'), size))
+}
+
+fn kind_name(kind: char) -> &'static str {
+    match kind {
+        'b' => "boolean",
+        'i' => "signed integer",
+        'u' => "unsigned integer",
+        'f' => "floating point",
+        'c' => "complex",
+        'U' | 'S' => "string",
+        'O' => "Python objects",
+        _ => "not numeric",
+    }
 }
 
 /// Lightmap UVs, one (u, v) per polygon corner.

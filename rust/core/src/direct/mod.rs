@@ -31,6 +31,12 @@ pub fn direct_irradiance(
         .iter()
         .map(|&(t, _)| el.tri_region[t as usize])
         .collect();
+    // Many-edged faces' outlines for the area-light booleans (see geom::simplify).
+    let simple: Vec<Option<Vec<DVec3>>> = scene
+        .faces
+        .par_iter()
+        .map(|f| crate::geom::simplify::simplified(&f.verts))
+        .collect();
     let done = std::sync::atomic::AtomicUsize::new(0);
     let results: Vec<(DVec3, [u64; 3])> = (0..nv)
         .into_par_iter()
@@ -45,7 +51,7 @@ pub fn direct_irradiance(
             let mut regions: Vec<u32> = around[count[v] as usize..count[v + 1] as usize].to_vec();
             regions.sort_unstable();
             regions.dedup();
-            vertex_direct(scene, tol, el, v, &regions)
+            vertex_direct(scene, tol, el, v, &regions, &simple)
         })
         .collect();
     progress.check()?;
@@ -68,6 +74,7 @@ fn vertex_direct(
     el: &Elements,
     v: usize,
     regions: &[u32],
+    simple: &[Option<Vec<DVec3>>],
 ) -> (DVec3, [u64; 3]) {
     let p = el.eval[v];
     let n = el.normals[v];
@@ -153,7 +160,15 @@ fn vertex_direct(
                 plane,
                 *radiance,
                 relation,
-                &polys,
+                &face_refs
+                    .iter()
+                    .map(|&f| {
+                        simple[f as usize]
+                            .as_deref()
+                            .unwrap_or(scene.faces[f as usize].verts.as_slice())
+                    })
+                    .chain(owned.iter().map(|v| v.as_slice()))
+                    .collect::<Vec<_>>(),
                 scene.settings.penumbra_visibility,
                 scene.settings.penumbra_samples,
             ),

@@ -9,6 +9,7 @@ pub mod lambert;
 pub mod plane;
 pub mod polygon;
 pub mod raycast;
+pub mod simplify;
 pub mod union_find;
 
 pub use frame::Frame;

@@ -4,6 +4,8 @@
 //! lights (`sizing`), then Delaunay refinement fixes angles. Edges across which some light jumps from lit to umbra (D0:
 //! contact shadows, point-light shadows) get two vertex rows, one per side.
 
+pub mod cancel;
+pub mod coverage;
 pub mod elements;
 pub mod sizing;
 
@@ -51,6 +53,7 @@ pub fn mesh_receiver(
     settings: &Settings,
     tol: &Tolerances,
     budget: &AtomicU64,
+    progress: &crate::Progress,
 ) -> Result<ReceiverMesh, BakeError> {
     let arr = &rr.arrangement;
     let mut cdt = Cdt::new();
@@ -64,7 +67,10 @@ pub fn mesh_receiver(
         handle.insert(v, h);
         Some(h)
     };
-    for &e in &rr.kept_edges {
+    for (k, &e) in rr.kept_edges.iter().enumerate() {
+        if k % 1024 == 0 {
+            progress.check()?;
+        }
         let [a, b] = arr.edges[e as usize].v;
         let (Some(ha), Some(hb)) = (vh(&mut cdt, a), vh(&mut cdt, b)) else {
             continue;
@@ -80,6 +86,7 @@ pub fn mesh_receiver(
     let corners = Corners::new(&rr.d0_lines, coarse);
     let mut seeds = Vec::new();
     for (f, rf) in arr.faces.iter().zip(&rr.faces) {
+        progress.check()?;
         let penumbra = !settings.uniform && rf.relations.iter().any(|r| *r == Relation::Penumbra);
         let seen = |l: usize| rf.relations.get(l).is_some_and(|r| *r != Relation::Umbra);
         let size = |p: DVec2, reach: f64| {
@@ -103,9 +110,13 @@ pub fn mesh_receiver(
             ),
         ));
     }
-    for p in seeds {
+    for (k, p) in seeds.into_iter().enumerate() {
+        if k % 4096 == 0 {
+            progress.check()?;
+        }
         let _ = cdt.insert(Point2::new(p.x, p.y));
     }
+    progress.check()?;
     let coarse_area = 0.433 * coarse * coarse;
     let fine = sizing
         .smallest()
@@ -114,13 +125,15 @@ pub fn mesh_receiver(
     let fine_area = 0.433 * fine * fine;
     let extra =
         (settings.max_elements.saturating_sub(used) as usize).min(cdt.num_vertices() * 4 + 64);
-    cdt.refine(
+    cancel::refine_in_rounds(
+        &mut cdt,
         RefinementParameters::new()
             .with_angle_limit(AngleLimit::from_deg(settings.min_angle))
             .with_max_allowed_area(coarse_area * 1.5)
-            .with_min_required_area(fine_area * 0.02)
-            .with_max_additional_vertices(extra),
-    );
+            .with_min_required_area(fine_area * 0.02),
+        extra,
+        progress,
+    )?;
     budget.fetch_add(
         cdt.num_vertices() as u64 - handle.len() as u64,
         Ordering::Relaxed,
@@ -133,6 +146,7 @@ pub fn mesh_receiver(
         })];
         return Ok(m);
     }
+    progress.check()?;
     Ok(extract(&cdt, rr, sizing.frame(), false, tol))
 }
 

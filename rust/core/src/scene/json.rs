@@ -19,8 +19,8 @@ pub struct SceneJson {
     pub settings: SettingsJson,
 }
 
-/// One colour per polygon, or one colour for the whole mesh.
-#[derive(Debug, Clone, Serialize, Deserialize)]
+/// One colour per polygon, or one colour for the whole mesh. (Deserialize is in `strict`.)
+#[derive(Debug, Clone, Serialize)]
 #[serde(untagged)]
 pub enum PerPolygon {
     Uniform([f64; 3]),
@@ -123,10 +123,9 @@ pub struct SettingsJson {
 }
 
 impl SceneJson {
-    /// Parses scene JSON text and checks `format` and `version`.
+    /// Parses scene JSON text (strictly: see `strict`) and checks `format` and `version`.
     pub fn from_str(text: &str) -> Result<Self, crate::BakeError> {
-        let s: SceneJson =
-            serde_json::from_str(text).map_err(|e| crate::BakeError::Format(e.to_string()))?;
+        let s = super::strict::scene_from_str(text)?;
         if s.format != SCENE_FORMAT {
             return Err(crate::BakeError::Format(format!(
                 "format is {:?}, expected {SCENE_FORMAT:?}",

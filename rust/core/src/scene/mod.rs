@@ -3,8 +3,11 @@
 
 pub mod convex;
 pub mod json;
+pub mod precision;
+pub mod reach;
 pub mod settings;
 pub mod solids;
+pub mod strict;
 pub mod tolerances;
 pub mod validate;
 

@@ -37,6 +37,8 @@ pub struct Settings {
 }
 
 pub const DEFAULT_MAX_ELEMENTS: u64 = 4_000_000;
+/// Largest `threads` accepted (the CLI's `--threads` too): past it a pool only costs memory.
+pub const MAX_THREADS: u32 = 1024;
 
 impl Settings {
     /// Defaults for a scene whose bounding box has diagonal `diag`.
@@ -121,10 +123,10 @@ impl Settings {
         }
         let max_shots = s.max_shots.unwrap_or(100_000);
         if let Some(t) = s.threads {
-            if t == 0 || t > 1024 {
+            if t == 0 || t > MAX_THREADS {
                 return Err(BakeError::setting(
                     "threads",
-                    format!("{t} must be in [1, 1024]"),
+                    format!("{t} must be in [1, {MAX_THREADS}]"),
                 ));
             }
         }

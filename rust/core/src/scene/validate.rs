@@ -78,6 +78,8 @@ pub fn validate(s: &SceneJson) -> Result<Scene, BakeError> {
         }
         lights.push(light);
     }
+    warnings.extend(super::reach::light_warnings(&lights, &faces));
+    super::precision::check(&meshes, &faces, lo, hi)?;
     let diag = (hi - lo).length();
     let settings = Settings::from_json(&s.settings, diag)?;
 

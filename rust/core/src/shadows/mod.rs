@@ -135,7 +135,7 @@ pub fn shadow_polygons(
             .par_iter()
             .enumerate()
             .map(|(oi, o)| {
-                if buried.occluders[oi] {
+                if buried.occluders[oi] || progress.is_cancelled() {
                     return Vec::new();
                 }
                 occluder_volumes(&light.kind, None, oi as u32, o, faces, eps)
@@ -188,7 +188,8 @@ pub fn shadow_polygons(
             .par_iter()
             .enumerate()
             .map(|(ri, r)| {
-                if buried.faces[ri] {
+                // A cancelled bake skips the rest of the receivers (checked after the loop).
+                if buried.faces[ri] || progress.is_cancelled() {
                     return OnReceiver::hidden();
                 }
                 receiver_polygons(
@@ -203,6 +204,7 @@ pub fn shadow_polygons(
                 )
             })
             .collect();
+        progress.check()?;
         for (ri, res) in results.into_iter().enumerate() {
             per_receiver[ri].exposure[li] = res.exposure;
             per_receiver[ri].polys.extend(res.polys);
@@ -231,11 +233,15 @@ pub fn shadow_polygons(
     }
     let t2 = std::time::Instant::now();
     per_receiver.par_iter_mut().zip(faces).for_each(|(r, f)| {
+        if progress.is_cancelled() {
+            return;
+        }
         crate::shadows::umbra_pruning::drop_covered(&mut r.polys, &r.inside);
         let snap = tol.snap(f);
         crate::shadows::umbra_pruning::trim_lines(r, snap, !keep_contacts);
     });
     stats.t_isr += t2.elapsed().as_secs_f64();
+    progress.check()?;
     Ok((per_receiver, stats))
 }
 

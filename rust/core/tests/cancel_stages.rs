@@ -1,0 +1,79 @@
+//! `cancel()` ends a bake within a second in the stages before indirect light (the indirect
+//! stage is being rewritten with its own bound and cancellation): a watcher cancels as soon
+//! as the bake enters the stage, and the bake must return `Cancelled` promptly.
+
+mod common;
+use common::*;
+use penumbra::{BakeError, Progress};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// 600 small quads at mixed heights over a floor under two lights: every stage has
+/// thousands of units of work (receivers, shadow pairs, vertices).
+fn busy_scene() -> penumbra::Scene {
+    let mut quads = Vec::new();
+    let side = 25;
+    for k in 0..side * side {
+        let (i, j) = ((k % side) as f64, (k / side) as f64);
+        let z = 0.4 + 0.05 * ((k * 7) % 9) as f64;
+        quads.push(quad(
+            [-1.5 + 0.12 * i, -1.5 + 0.12 * j, z],
+            0.04,
+            0.04,
+            true,
+        ));
+    }
+    let meshes = vec![
+        mesh("Floor", vec![quad([0., 0., 0.], 2., 2., true)]),
+        mesh("Quads", quads),
+    ];
+    let lights = vec![
+        area_light("Key", quad([0.3, 0.2, 2.0], 0.4, 0.3, false)),
+        area_light("Fill", quad([-0.5, -0.4, 2.4], 0.3, 0.3, false)),
+    ];
+    let s = scene(
+        meshes,
+        lights,
+        penumbra::scene::json::SettingsJson {
+            indirect: Some(false),
+            ..Default::default()
+        },
+    );
+    penumbra::scene::validate(&s).unwrap()
+}
+
+#[test]
+fn cancel_returns_within_a_second_in_every_stage() {
+    let scene = busy_scene();
+    // Not yet "discontinuity loops": one receiver's arrangement (here the floor under 1,250
+    // shadow polygons) is built in one uninterruptible call, seconds long in the dev profile.
+    for stage in ["shadow volumes", "meshing", "direct light"] {
+        let p = Arc::new(Progress::new());
+        let q = p.clone();
+        let watcher = std::thread::spawn(move || loop {
+            if q.get().0 == stage {
+                q.cancel();
+                return Some(Instant::now());
+            }
+            if q.is_cancelled() {
+                return None;
+            }
+            std::thread::sleep(Duration::from_micros(200));
+        });
+        let r = penumbra::bake(&scene, &p);
+        let returned = Instant::now();
+        p.cancel(); // stops the watcher if the bake ended before reaching the stage
+        let cancelled_at = watcher.join().unwrap();
+        let Some(at) = cancelled_at else {
+            panic!("{stage}: the bake finished before the stage was seen ({r:?})");
+        };
+        // A stage can finish between the watcher's cancel and its next check: then the
+        // next stage's check returns Cancelled. Either way, promptly.
+        assert_eq!(r.unwrap_err(), BakeError::Cancelled, "{stage}");
+        let took = returned.saturating_duration_since(at);
+        assert!(
+            took < Duration::from_secs(1),
+            "{stage}: cancel took {took:?}"
+        );
+    }
+}
