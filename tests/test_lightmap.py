@@ -205,3 +205,32 @@ def test_escape_during_a_lightmap_bake_takes_the_new_uv_maps_back(room_scene, em
     assert op.modal(ctx, _Event("ESC", "PRESS")) == {"CANCELLED"}
     # ... and are gone once it is cancelled.
     assert full_snapshot() == before
+
+
+@pytest.mark.parametrize("mirrored", [False, True])
+def test_exported_uvs_follow_the_exported_corners(empty, mirrored):
+    # Each exported UV must belong to the corner it stands beside in polygon_vertices, also
+    # when a mirroring transform reverses every polygon's corners.
+    from test_addon import _area_light, _cube
+
+    from penumbra.export import export_scene
+
+    cube = _cube(location=(0, 0, 3))
+    if mirrored:
+        cube.scale = (-1.0, 1.0, 1.0)
+    _area_light(z=6.0)
+    me = cube.data
+    layer = me.uv_layers.new(name="Lightmap")
+    loop_vert = np.empty(len(me.loops), dtype=np.int64)
+    me.loops.foreach_get("vertex_index", loop_vert)
+    co = np.empty(3 * len(me.vertices))
+    me.vertices.foreach_get("co", co)
+    co = co.reshape(-1, 3)
+    # UV = a function of the corner's vertex (not a valid unwrap; only the pairing matters).
+    uv_of_vertex = 0.5 + 0.2 * co[:, :2] + 0.05 * co[:, 2:3]
+    layer.uv.foreach_set("vector", uv_of_vertex[loop_vert].astype(np.float32).ravel())
+    cube.select_set(True)
+    empty.scene.penumbra.output = "LIGHTMAP"
+    ex = export_scene(empty, empty.scene.penumbra)
+    (m,) = ex.scene["meshes"]
+    np.testing.assert_allclose(m["uv"], uv_of_vertex[m["polygon_vertices"]], atol=1e-6)

@@ -242,3 +242,37 @@ fn a_bake_of_another_mesh_is_refused() {
     .to_string();
     assert!(e.contains("source_polygon[1]"), "{e}");
 }
+
+#[test]
+fn concave_and_non_planar_polygons_cover_exactly_their_uv_area() {
+    // An L (concave: ear-clipped) and a bent quad (non-planar: its two triangles on their
+    // own planes), both with UV = (x, y) / 4: the covered area must be the UV area.
+    let text = r#"{"format": "penumbra-scene", "version": 1,
+        "meshes": [{"name": "Floor",
+            "positions": [[0,0,0],[4,0,0],[4,1,0],[1,1,0],[1,4,0],[0,4,0],
+                          [2,2,0],[4,2,0],[4,4,0.3],[2,4,0]],
+            "polygons": [[0,1,2,3,4,5],[6,7,8,9]],
+            "uv": [[0,0],[1,0],[1,0.25],[0.25,0.25],[0.25,1],[0,1],
+                   [0.5,0.5],[1,0.5],[1,1],[0.5,1]]}],
+        "lights": [{"name": "Sun", "direction": [0.1, 0.2, -1], "irradiance": [1,1,1]}],
+        "settings": {"indirect": false, "lightmap_resolution": 16, "lightmap_margin": 0}}"#;
+    let json = SceneJson::from_str(text).unwrap();
+    let bake = bake_scene_json(text, &Progress::new()).unwrap();
+    let lm = scene_lightmaps(&json, &bake, &Progress::new()).unwrap()[0]
+        .clone()
+        .unwrap();
+    let covered: f64 = lm.coverage.iter().map(|&c| c as f64).sum();
+    // L: 4·1 + 1·3 = 7 m² = 7/16 of the UV square; quad: 1/4 of it; 256 texels.
+    let want = (7.0 / 16.0 + 0.25) * 256.0;
+    assert!((covered - want).abs() < 1e-3, "{covered} vs {want}");
+    // The L's notch (x, y in (1, 2)) is empty.
+    for j in 5..8 {
+        for i in 5..8 {
+            assert_eq!(lm.coverage[j * 16 + i], 0.0, "{i},{j}");
+        }
+    }
+    // The sun lights every covered texel.
+    for (c, rgb) in lm.coverage.iter().zip(&lm.rgb) {
+        assert_eq!(*c > 0.0, rgb[0] > 0.0);
+    }
+}
