@@ -168,11 +168,11 @@ def run(args):
         os.makedirs(os.path.dirname(gltf), exist_ok=True)
         if settings.output == "MESH":
             objects = [bpy.data.objects[n] for n in outputs.get("objects", [])]
-            gltf_out = importlib.import_module(package + ".gltf_out")
+            gltf_out = importlib.import_module(package + ".blender.gltf_out")
             with gltf_out.unlit_vertex_colours(objects):
                 export_gltf(objects, gltf)
         else:
-            gltf_out = importlib.import_module(package + ".gltf_out")
+            gltf_out = importlib.import_module(package + ".blender.gltf_out")
             sources = [bpy.data.objects[n[: -len(gltf_out.IMAGE_SUFFIX)]] for n in outputs.get("images", [])]
             with gltf_out.lightmapped(sources, [bpy.data.images[n] for n in outputs.get("images", [])]):
                 export_gltf(sources, gltf)

@@ -25,43 +25,21 @@ import numpy as np  # noqa: E402
 
 import penumbra  # noqa: E402
 import room  # noqa: E402
-
-
-def lambert(name, color):
-    mat = bpy.data.materials.new(name)
-    if bpy.app.version < (5, 0, 0):
-        mat.use_nodes = True
-    tree = mat.node_tree
-    tree.nodes.clear()
-    out = tree.nodes.new("ShaderNodeOutputMaterial")
-    bsdf = tree.nodes.new("ShaderNodeBsdfDiffuse")
-    bsdf.inputs["Color"].default_value = (*color, 1.0)
-    bsdf.inputs["Roughness"].default_value = 0.0
-    tree.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
-    return mat
+import cycles_setup  # noqa: E402
 
 
 def build():
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    scene = bpy.context.scene
-    scene.render.engine = "CYCLES"
+    # Samples and seed are set per bake (cycles_bake).
+    scene = cycles_setup.reset_scene(samples=1, seed=0, bounces=64)
     cy = scene.cycles
-    cy.device = "CPU"
-    cy.use_adaptive_sampling = False
-    cy.use_denoising = False
-    cy.sample_clamp_direct = cy.sample_clamp_indirect = 0.0
-    cy.max_bounces = cy.diffuse_bounces = 64
     cy.glossy_bounces = cy.transmission_bounces = cy.volume_bounces = cy.transparent_max_bounces = 0
-    scene.world = None
-    scene.render.threads_mode = "FIXED"
-    scene.render.threads = max(1, min(2, os.cpu_count() or 1))
     meshes, light = room.build_room(scene)
     made = {}
     for o in meshes:
         for slot in o.material_slots:
             m = slot.material
             if m.name not in made:
-                made[m.name] = lambert(m.name + " Lambert", tuple(m.diffuse_color)[:3])
+                made[m.name] = cycles_setup.lambert_material(m.name + " Lambert", tuple(m.diffuse_color)[:3])
             slot.material = made[m.name]
     return scene, meshes, light
 

@@ -40,6 +40,8 @@ def lambert_material(name: str, albedo=(1.0, 1.0, 1.0), emission=None):
     import bpy
 
     mat = bpy.data.materials.new(name)
+    if bpy.app.version < (5, 0, 0):  # node trees are always on from Blender 5
+        mat.use_nodes = True
     nt = mat.node_tree
     nt.nodes.clear()
     out = nt.nodes.new("ShaderNodeOutputMaterial")

@@ -17,7 +17,9 @@ SRC = os.path.join(ROOT, "addon", "penumbra")
 def package(out_dir):
     manifest = os.path.join(SRC, "blender_manifest.toml")
     version = re.search(r'^version = "([^"]+)"', open(manifest).read(), re.M).group(1)
-    files = sorted(glob.glob(os.path.join(SRC, "*.py")) + glob.glob(os.path.join(SRC, "_core*.so")))
+    files = sorted(
+        glob.glob(os.path.join(SRC, "**", "*.py"), recursive=True) + glob.glob(os.path.join(SRC, "_core*.so"))
+    )
     if not any(f.endswith(".so") for f in files):
         raise SystemExit("package: the compiled module is missing from addon/penumbra (run scripts/setup)")
     files.append(manifest)
@@ -29,7 +31,7 @@ def package(out_dir):
         path = os.path.join(out_dir, name)
         with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
             for f in files:
-                z.write(f, prefix + os.path.basename(f))
+                z.write(f, prefix + os.path.relpath(f, SRC))
         print("package: wrote %s (%d files, %.1f MB)" % (path, len(files), os.path.getsize(path) / 1e6))
         written.append(path)
     return written

@@ -2,7 +2,7 @@
 "Bake Radiosity" as a click would (modal, on the Rust thread), waits for the bake, then
 undoes once. Writes what it saw as JSON to the path after "--".
 
-Blender 3.4 lacks the light settings cycles_lights reads (Light.normalize is Blender 4), so
+Blender 3.4 lacks the light settings io/lights.py reads (Light.normalize is Blender 4), so
 this session converts its one area light itself and leaves the meshes without materials:
 what is under test here is the operator's modal path and its undo step.
 """
@@ -20,7 +20,7 @@ import bpy  # noqa: E402
 from mathutils import Vector  # noqa: E402
 
 import penumbra  # noqa: E402
-import penumbra.export  # noqa: E402
+import penumbra.blender.export  # noqa: E402
 import room  # noqa: E402
 
 OUT = sys.argv[sys.argv.index("--") + 1]
@@ -48,7 +48,7 @@ def finish():
 def start():
     try:
         penumbra.register()
-        penumbra.export.lights_to_scene = square_light
+        penumbra.blender.export.lights_to_scene = square_light
         for o in list(bpy.data.objects):
             bpy.data.objects.remove(o)
         meshes, light = room.build_room()

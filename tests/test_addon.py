@@ -10,9 +10,9 @@ from conftest import Reports, snapshot
 
 import room
 from penumbra import BakeError, _core
-from penumbra.export import ExportError, export_scene
-from penumbra.import_ import ATTRIBUTE, COLLECTION, MATERIAL, import_bake
-from penumbra.operators import bake_blocking
+from penumbra.blender.export import ExportError, export_scene
+from penumbra.blender.import_ import ATTRIBUTE, COLLECTION, MATERIAL, import_bake
+from penumbra.blender.operators import bake_blocking
 
 ROOM_MESHES = ["Floor", "Ceiling", "Wall Left", "Wall Right", "Wall Back", "Wall Front", "Table", "Chair"]
 
@@ -385,7 +385,7 @@ def test_modal_escape_cancels_and_changes_nothing(room_scene, empty, monkeypatch
     empty.scene.penumbra.quality = "HIGH"
     before = snapshot()
     op, ctx = _modal_op(), _Context()
-    import penumbra.operators as ops
+    import penumbra.blender.operators as ops
 
     monkeypatch.setattr(ops, "has_ui", lambda context: True)
     assert op.invoke(ctx, _Event("NONE")) == {"RUNNING_MODAL"}
@@ -398,7 +398,7 @@ def test_modal_escape_cancels_and_changes_nothing(room_scene, empty, monkeypatch
 
 
 def test_modal_timer_polls_until_the_bake_is_imported(room_scene, empty, monkeypatch):
-    import penumbra.operators as ops
+    import penumbra.blender.operators as ops
 
     monkeypatch.setattr(ops, "has_ui", lambda context: True)
     op, ctx = _modal_op(), _Context()
@@ -417,7 +417,7 @@ def test_modal_timer_polls_until_the_bake_is_imported(room_scene, empty, monkeyp
 
 
 def test_overall_progress_follows_the_pipeline():
-    from penumbra.operators import overall_fraction
+    from penumbra.blender.operators import overall_fraction
 
     names = ["validate", "shadow volumes", "discontinuity loops", "meshing", "direct light", "indirect light"]
     values = [overall_fraction(n, 0.5) for n in names]

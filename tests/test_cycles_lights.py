@@ -18,7 +18,7 @@ import pytest
 bpy = pytest.importorskip("bpy")
 
 import cycles_ref as cr  # noqa: E402  (also puts addon/ on sys.path)
-from penumbra.cycles_lights import (  # noqa: E402
+from penumbra.io.lights import (  # noqa: E402
     DEFAULT_DISK_SEGMENTS,
     UnsupportedLightError,
     lights_to_scene,

@@ -10,9 +10,9 @@ import pytest
 from conftest import Reports, snapshot
 
 from penumbra import _core
-from penumbra.import_ import COLLECTION
-from penumbra.lightmap_preview import PREFIX
-from penumbra.operators import bake_blocking
+from penumbra.blender.import_ import COLLECTION
+from penumbra.blender.lightmap_preview import PREFIX
+from penumbra.blender.operators import bake_blocking
 
 RES = 32
 
@@ -192,7 +192,7 @@ def test_core_lightmap_binding_matches_a_hand_made_field():
 def test_escape_during_a_lightmap_bake_takes_the_new_uv_maps_back(room_scene, empty, monkeypatch):
     from test_addon import _Context, _Event, _modal_op
 
-    import penumbra.operators as ops
+    import penumbra.blender.operators as ops
 
     _lightmap_settings(empty.scene)
     empty.scene.penumbra.quality = "HIGH"
@@ -213,7 +213,7 @@ def test_exported_uvs_follow_the_exported_corners(empty, mirrored):
     # when a mirroring transform reverses every polygon's corners.
     from test_addon import _area_light, _cube
 
-    from penumbra.export import export_scene
+    from penumbra.blender.export import export_scene
 
     cube = _cube(location=(0, 0, 3))
     if mirrored:

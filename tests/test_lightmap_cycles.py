@@ -22,7 +22,7 @@ import numpy as np
 import cycles_ref as cr
 import room
 from conftest import Reports
-from penumbra.operators import bake_blocking
+from penumbra.blender.operators import bake_blocking
 
 RES = 64
 SAMPLES = 256

@@ -12,7 +12,7 @@ import pytest
 bpy = pytest.importorskip("bpy")
 
 import cycles_ref as cr  # noqa: E402  (also puts addon/ on sys.path)
-from penumbra.materials import (  # noqa: E402
+from penumbra.io.materials import (  # noqa: E402
     DEFAULT_ALBEDO,
     material_colors,
     polygon_colors,

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import cycles_ref as cr
-from penumbra.import_ import ATTRIBUTE
+from penumbra.blender.import_ import ATTRIBUTE
 
 SAMPLES = 1024
 GRID = 7  # vertices per side of each wall

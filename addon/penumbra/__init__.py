@@ -30,7 +30,7 @@ __all__ = ["BakeError", "register", "unregister"]
 
 def _modules():
     # Imported here, not at the top, so that the binding works without bpy.
-    from . import props, operators, ui
+    from .blender import operators, props, ui
 
     return (props, operators, ui)
 

@@ -4,7 +4,7 @@
   are the probe lattices (same geometry, more vertices), with a Diffuse BSDF of the
   polygon's albedo (plus an Emission of its emission radiance). Rectangular light polygons
   become RECTANGLE area lights of power P = L·π·A (Blender's convention L = P/(π·A), see
-  addon/penumbra/cycles_lights.py); other polygons become one-sided emissive faces.
+  addon/penumbra/io/lights.py); other polygons become one-sided emissive faces.
 * `baked_scene`: a bake JSON as meshes with an emission shader reading the colour
   attribute, for rendering what Penumbra baked.
 """

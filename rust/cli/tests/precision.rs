@@ -44,21 +44,7 @@ fn quad(lo: [f64; 2], hi: [f64; 2], z: f64) -> Vec<[f64; 3]> {
 }
 
 fn mesh(name: &str, polys: Vec<Vec<[f64; 3]>>) -> MeshJson {
-    let mut positions = Vec::new();
-    let mut polygons = Vec::new();
-    for p in polys {
-        let at = positions.len() as i64;
-        polygons.push((0..p.len() as i64).map(|k| at + k).collect());
-        positions.extend(p);
-    }
-    MeshJson {
-        name: name.into(),
-        positions,
-        polygons,
-        albedo: None,
-        emission: None,
-        uv: None,
-    }
+    penumbra::scenes::polygons_mesh(name, polys, None)
 }
 
 /// A 1 m box (its top and sides) standing on a floor reaching ±1e12, under an area light.

@@ -9,6 +9,12 @@ use crate::scene::json::{LightJson, MeshJson, PerPolygon, SceneJson, SettingsJso
 type P = [f64; 3];
 
 fn mesh(name: &str, polys: Vec<Vec<P>>, albedo: [f64; 3]) -> MeshJson {
+    polygons_mesh(name, polys, Some(albedo))
+}
+
+/// A mesh of separate polygons (no shared vertices), with one albedo for all or the
+/// format's default.
+pub fn polygons_mesh(name: &str, polys: Vec<Vec<P>>, albedo: Option<[f64; 3]>) -> MeshJson {
     let mut positions = Vec::new();
     let mut polygons = Vec::new();
     for p in polys {
@@ -20,7 +26,7 @@ fn mesh(name: &str, polys: Vec<Vec<P>>, albedo: [f64; 3]) -> MeshJson {
         name: name.into(),
         positions,
         polygons,
-        albedo: Some(PerPolygon::Uniform(albedo)),
+        albedo: albedo.map(PerPolygon::Uniform),
         emission: None,
         uv: None,
     }

@@ -21,21 +21,7 @@ pub fn quad(c: [f64; 3], hx: f64, hy: f64, up: bool) -> Vec<[f64; 3]> {
 }
 
 pub fn mesh(name: &str, polys: Vec<Vec<[f64; 3]>>) -> MeshJson {
-    let mut positions = Vec::new();
-    let mut polygons = Vec::new();
-    for p in polys {
-        let start = positions.len() as i64;
-        polygons.push((0..p.len() as i64).map(|i| start + i).collect());
-        positions.extend(p);
-    }
-    MeshJson {
-        name: name.into(),
-        positions,
-        polygons,
-        albedo: None,
-        emission: None,
-        uv: None,
-    }
+    penumbra::scenes::polygons_mesh(name, polys, None)
 }
 
 pub fn area_light(name: &str, polygon: Vec<[f64; 3]>) -> LightJson {

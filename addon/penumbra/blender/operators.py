@@ -9,7 +9,8 @@ import time
 
 import bpy
 
-from . import _core, lightmap_preview, lightmaps
+from .. import _core
+from . import lightmap_preview, lightmaps
 from .export import ExportError, _sources, export_scene
 from .import_ import import_bake
 

@@ -6,24 +6,11 @@ modifiers, in world space, and the lights in scene-JSON form. Only numpy and
 import bpy
 import numpy as np
 
-from .props import QUALITY_FRACTIONS
+from ..io.lights import lights_to_scene
+from ..io.materials import polygon_colors
+from ..io.scene import LIGHTMAP_UV, MESH_TYPES, SOURCE_KEY, ExportError, loop_order, polygon_area, settings_dict
 
-from .cycles_lights import lights_to_scene
-from .materials import polygon_colors
-
-# Custom property of a baked object: the name of the object it was baked from.
-SOURCE_KEY = "penumbra_source"
-
-# The UV map lightmaps are baked onto (created by the add-on with Lightmap Pack when missing).
-LIGHTMAP_UV = "Lightmap"
-
-# Object types that evaluate to a mesh.
-MESH_TYPES = {"MESH", "CURVE", "SURFACE", "FONT", "META"}
-
-
-class ExportError(Exception):
-    """Bad input found before the bake: the message names the object and the field."""
-
+__all__ = ["LIGHTMAP_UV", "SOURCE_KEY", "ExportError", "Export", "export_scene"]
 
 class Export:
     """What a bake needs: the scene for the core and the source objects, in mesh order."""
@@ -66,7 +53,7 @@ def export_scene(context, settings, objects=None):
     if not light_dicts and not emissive:
         raise ExportError("No lights: add a light or select one (or give a material emission)")
 
-    scene = {"meshes": meshes, "lights": light_dicts, "settings": _settings(settings, meshes, light_dicts)}
+    scene = {"meshes": meshes, "lights": light_dicts, "settings": settings_dict(settings, meshes, light_dicts)}
     return Export(scene, sources, lights, warnings)
 
 
@@ -112,7 +99,7 @@ def _mesh(obj, depsgraph, warnings, want_uv=False):
         mesh.polygons.foreach_get("loop_total", counts)
         loop_vert = np.empty(len(mesh.loops), dtype=np.int64)
         mesh.loops.foreach_get("vertex_index", loop_vert)
-        order = _loop_order(starts, counts, np.linalg.det(m[:3, :3]) < 0.0)
+        order = loop_order(starts, counts, np.linalg.det(m[:3, :3]) < 0.0)
         polygon_vertices = loop_vert[order]
 
         albedo, emission = polygon_colors(obj_eval, mesh, warnings)
@@ -144,17 +131,6 @@ def _lightmap_uv(obj, mesh, order):
     return uv.reshape(-1, 2).astype(np.float64)[order]
 
 
-def _loop_order(starts, counts, mirrored):
-    """Loop indices polygon after polygon. A mirroring transform turns counter-clockwise
-    into clockwise, so then each polygon's loops are reversed to keep its front."""
-    total = int(counts.sum())
-    offsets = np.concatenate(([0], np.cumsum(counts)[:-1])) if len(counts) else counts
-    within = np.arange(total) - np.repeat(offsets, counts)
-    if mirrored:
-        within = np.repeat(counts, counts) - 1 - within
-    return np.repeat(starts, counts) + within
-
-
 def _light(obj, depsgraph):
     light = obj.data
     if light.type == "AREA":
@@ -173,34 +149,6 @@ def _light(obj, depsgraph):
         raise ExportError(str(e))
     for d in dicts:
         polygon = d.get("polygon")
-        if polygon is not None and _polygon_area(np.asarray(polygon, dtype=np.float64)) <= 0.0:
+        if polygon is not None and polygon_area(np.asarray(polygon, dtype=np.float64)) <= 0.0:
             raise ExportError('Light "%s": size: the light polygon has no area' % obj.name)
     return dicts
-
-
-def _polygon_area(p):
-    if len(p) < 3 or not np.isfinite(p).all():
-        return 0.0
-    return 0.5 * float(np.linalg.norm(np.cross(p - p[0], np.roll(p, -1, axis=0) - p[0]).sum(axis=0)))
-
-
-def _settings(settings, meshes, lights):
-    pts = [m["positions"] for m in meshes if len(m["positions"])]
-    for d in lights:
-        for key in ("polygon", "point"):
-            if d.get(key) is not None:
-                pts.append(np.asarray(d[key], dtype=np.float64).reshape(-1, 3))
-    allp = np.concatenate(pts) if pts else np.zeros((1, 3))
-    diag = float(np.linalg.norm(allp.max(axis=0) - allp.min(axis=0))) or 1.0
-    if settings.use_custom_size:
-        element, penumbra = settings.element_size, settings.penumbra_element_size
-    else:
-        coarse, fine = QUALITY_FRACTIONS[settings.quality]
-        element, penumbra = coarse * diag, fine * diag
-    return {
-        "element_size": float(element),
-        "penumbra_element_size": float(min(penumbra, element)),
-        "indirect": bool(settings.use_indirect),
-        "convergence": float(settings.convergence),
-        "lighting_only": bool(settings.lighting_only),
-    }

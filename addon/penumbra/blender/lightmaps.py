@@ -15,7 +15,7 @@ import os
 import bpy
 import numpy as np
 
-from . import _core
+from .. import _core
 from .export import LIGHTMAP_UV, ExportError
 
 IMAGE_SUFFIX = "_radiosity"

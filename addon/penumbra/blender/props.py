@@ -3,14 +3,6 @@
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 
-# Element edge lengths as fractions of the scene's bounding-box diagonal: (outside penumbra,
-# inside penumbra). Medium's outside size is the core's own default; its penumbra size is
-# finer than the core's (element_size/2).
-QUALITY_FRACTIONS = {
-    "DRAFT": (1.0 / 12.0, 1.0 / 40.0),
-    "MEDIUM": (1.0 / 25.0, 1.0 / 125.0),
-    "HIGH": (1.0 / 50.0, 1.0 / 400.0),
-}
 
 
 class PenumbraSettings(bpy.types.PropertyGroup):
