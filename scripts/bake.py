@@ -75,7 +75,9 @@ def ensure_addon():
 
     if hasattr(bpy.types.Scene, "penumbra") and hasattr(bpy.ops.penumbra, "bake"):
         # Regression: importing "penumbra.…" failed when the add-on ran as an extension.
-        return bpy.types.PENUMBRA_OT_bake.__module__.rpartition(".")[0]
+        # The operator lives in <package>.blender.operators.
+        module = bpy.types.PENUMBRA_OT_bake.__module__
+        return module[: -len(".blender.operators")] if module.endswith(".blender.operators") else module.rpartition(".")[0]
     _ensure_numpy()
     addon = os.path.join(ROOT, "addon")
     if addon not in sys.path:

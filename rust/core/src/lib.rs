@@ -22,10 +22,6 @@ pub mod geom;
 pub mod progress;
 pub mod scenes;
 
-// Moved into `indirect/` by the hierarchical-radiosity work.
-pub(crate) mod covered;
-pub(crate) mod patches;
-
 pub use bake::{bake, bake_scene_json, Bake, BakedMesh, Stats};
 pub use error::BakeError;
 pub use progress::Progress;

@@ -9,7 +9,7 @@ use super::blockers::Pair;
 use super::receiver::form_factor;
 use super::shooter::{Group, Shooter};
 use crate::geom::Plane;
-use crate::patches::Patch;
+use crate::indirect::patches::Patch;
 
 /// Groups with fewer vertices are evaluated vertex by vertex: a fit costs 13 evaluations.
 pub(super) const FIT_MIN_VERTS: usize = 24;

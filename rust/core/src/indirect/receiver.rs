@@ -9,7 +9,7 @@ use super::blockers::{Blockers, Pair};
 use super::shooter::{Group, Shooter};
 use super::{FEW_RAYS_BELOW, MAX_LISTED_OCCLUDERS, ONE_RAY_BELOW};
 use crate::geom::Plane;
-use crate::patches::Patch;
+use crate::indirect::patches::Patch;
 
 impl Shooter<'_> {
     /// Everything the shots sent to vertex `v`, computed there alone (`shot_all`: the

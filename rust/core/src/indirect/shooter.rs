@@ -12,8 +12,8 @@ use super::blockers::{Blockers, Pair, Reached};
 use super::gather::Gather;
 use super::{mean, CHUNK, FACTOR_BUDGET};
 use crate::geom::raycast::Occluders;
+use crate::indirect::patches::Patch;
 use crate::mesh::elements::Elements;
-use crate::patches::Patch;
 use crate::scene::Scene;
 
 /// What a shot needs about the scene, built once.

@@ -2,7 +2,7 @@
 
 use super::*;
 use crate::geom::Plane;
-use crate::patches::test::grid_elements;
+use crate::indirect::patches::test::grid_elements;
 use crate::scene::json::SettingsJson;
 use crate::scene::settings::Settings;
 use crate::scene::test::face;
@@ -678,7 +678,7 @@ fn fitted_far_groups_agree_with_vertex_by_vertex() {
     let sc = scene(vec![lamp, floor, panel], |s| s.patch_size = 0.5);
     let el = grid_elements(&sc.faces, 40);
     let occ = Occluders::new(&sc.faces);
-    let open = crate::covered::open_parts(&sc.faces, 1e-6 * sc.diagonal());
+    let open = crate::indirect::coplanar_contacts::open_parts(&sc.faces, 1e-6 * sc.diagonal());
     let patches = build_patches(&sc.faces, &open, &el, 0.5, sc.settings.visibility_rays);
     let nv = el.positions.len();
     let fitted = Shooter::new(

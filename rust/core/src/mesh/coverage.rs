@@ -49,9 +49,17 @@ pub fn check(scene: &Scene, out: &[BakedMesh]) -> Result<(), BakeError> {
                 ));
             };
             let v = tri.map(|i| DVec3::from_array(baked.positions[i as usize]));
-            let n = faces[own[0]].plane.n;
-            let signed = 0.5 * (v[1] - v[0]).cross(v[2] - v[0]).dot(n);
             let tol = DISTANCE_TOLERANCE * sizes[p] + 4.0 * weld;
+            // The piece the triangle lies in gives its facing: a non-planar polygon's pieces
+            // lie in planes of their own.
+            let centre = (v[0] + v[1] + v[2]) / 3.0;
+            let piece = own
+                .iter()
+                .copied()
+                .find(|&i| inside(&faces[i], ccw[i], centre, tol))
+                .unwrap_or(own[0]);
+            let n = faces[piece].plane.n;
+            let signed = 0.5 * (v[1] - v[0]).cross(v[2] - v[0]).dot(n);
             if signed < -(tol * tol) {
                 return Err(lost(&obj, p, "a triangle of the bake faces the other way"));
             }

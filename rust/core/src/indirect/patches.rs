@@ -7,10 +7,10 @@
 
 use glam::{DVec2, DVec3};
 
-use crate::covered::Open;
 use crate::geom::polygon::{
     clip_polygon_2d, signed_area_2d, simplify_convex, strictly_inside_convex, HalfPlane,
 };
+use crate::indirect::coplanar_contacts::Open;
 use crate::mesh::elements::Elements;
 use crate::scene::Face;
 
@@ -465,7 +465,7 @@ pub(crate) mod test {
     }
 
     fn open_of(f: &Face) -> Vec<Vec<Open>> {
-        crate::covered::open_parts(std::slice::from_ref(f), 1e-9)
+        crate::indirect::coplanar_contacts::open_parts(std::slice::from_ref(f), 1e-9)
     }
 
     fn square(s: f64) -> Face {
@@ -533,7 +533,7 @@ pub(crate) mod test {
             DVec3::ZERO,
         );
         let faces = [floor, bottom];
-        let open = crate::covered::open_parts(&faces, 1e-9);
+        let open = crate::indirect::coplanar_contacts::open_parts(&faces, 1e-9);
         let el = grid_elements(&faces, 8);
         let p = build_patches(&faces, &open, &el, 2.0, 16);
         assert!(p.iter().all(|q| q.face == 0));

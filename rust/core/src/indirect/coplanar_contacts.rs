@@ -21,6 +21,7 @@ pub struct Open {
 /// Per face, its uncovered part as disjoint convex pieces. A face with no cover has one
 /// piece, itself, without cuts; a face covered whole has none. `tol` is the distance under
 /// which two planes count as the same.
+#[cfg(test)]
 pub fn open_parts(faces: &[Face], tol: f64) -> Vec<Vec<Open>> {
     open_parts_of(faces, &covers(faces, tol), tol)
 }

@@ -25,9 +25,11 @@
 //! vertices, and the rest from them).
 
 mod blockers;
+pub(crate) mod coplanar_contacts;
 mod fit;
 mod gather;
 mod mls;
+pub(crate) mod patches;
 mod receiver;
 mod shooter;
 
@@ -42,8 +44,8 @@ use receiver::form_factor;
 use shooter::Shooter;
 
 use crate::geom::raycast::Occluders;
+use crate::indirect::patches::{build_patches, Patch};
 use crate::mesh::elements::Elements;
-use crate::patches::{build_patches, Patch};
 use crate::progress::Progress;
 use crate::scene::Scene;
 use crate::BakeError;
@@ -117,8 +119,8 @@ fn indirect_at(
         ));
     }
     let cover_tol = 1e-6 * scene.diagonal();
-    let covers = crate::covered::covers(&scene.faces, cover_tol);
-    let open = crate::covered::open_parts_of(&scene.faces, &covers, cover_tol);
+    let covers = crate::indirect::coplanar_contacts::covers(&scene.faces, cover_tol);
+    let open = crate::indirect::coplanar_contacts::open_parts_of(&scene.faces, &covers, cover_tol);
     let patches = build_patches(
         &scene.faces,
         &open,
