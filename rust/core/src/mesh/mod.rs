@@ -5,7 +5,6 @@
 //! contact shadows, point-light shadows) get two vertex rows, one per side.
 
 pub mod cancel;
-pub mod coverage;
 pub mod elements;
 pub mod sizing;
 

@@ -121,23 +121,3 @@ pub struct SettingsJson {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lightmap_margin: Option<i64>,
 }
-
-impl SceneJson {
-    /// Parses scene JSON text (strictly: see `strict`) and checks `format` and `version`.
-    pub fn from_str(text: &str) -> Result<Self, crate::BakeError> {
-        let s = super::strict::scene_from_str(text)?;
-        if s.format != SCENE_FORMAT {
-            return Err(crate::BakeError::Format(format!(
-                "format is {:?}, expected {SCENE_FORMAT:?}",
-                s.format
-            )));
-        }
-        if s.version != SCENE_VERSION {
-            return Err(crate::BakeError::Format(format!(
-                "version {} is not supported (this build reads version {SCENE_VERSION})",
-                s.version
-            )));
-        }
-        Ok(s)
-    }
-}

@@ -18,7 +18,7 @@ use serde::de::{self, DeserializeOwned, Deserializer, SeqAccess, Visitor};
 use serde::Deserialize;
 use serde_json::Value;
 
-use super::json::{LightJson, PerPolygon, SceneJson, SettingsJson};
+use super::json::{LightJson, PerPolygon, SceneJson, SettingsJson, SCENE_FORMAT, SCENE_VERSION};
 use crate::BakeError;
 
 /// One step of a path into the scene JSON.
@@ -288,6 +288,26 @@ impl<'de> Deserialize<'de> for PerPolygon {
             }
         }
         d.deserialize_seq(V)
+    }
+}
+
+impl SceneJson {
+    /// Parses scene JSON text (strictly: see `strict`) and checks `format` and `version`.
+    pub fn from_str(text: &str) -> Result<Self, crate::BakeError> {
+        let s = scene_from_str(text)?;
+        if s.format != SCENE_FORMAT {
+            return Err(crate::BakeError::Format(format!(
+                "format is {:?}, expected {SCENE_FORMAT:?}",
+                s.format
+            )));
+        }
+        if s.version != SCENE_VERSION {
+            return Err(crate::BakeError::Format(format!(
+                "version {} is not supported (this build reads version {SCENE_VERSION})",
+                s.version
+            )));
+        }
+        Ok(s)
     }
 }
 

@@ -1,5 +1,7 @@
 //! The whole bake, stage by stage, and its output (the bake JSON of DESIGN.md).
 
+mod coverage;
+
 use std::sync::atomic::AtomicU64;
 use std::time::Instant;
 
@@ -207,7 +209,7 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
     }
     let radiance = colors(scene, &elements, &irradiance);
     let out = output(scene, &tol, &elements, &radiance);
-    crate::mesh::coverage::check(scene, &out)?;
+    coverage::check(scene, &out)?;
     stats.T_total = t_start.elapsed().as_secs_f64();
     Ok(Bake {
         format: "penumbra-bake",
