@@ -30,18 +30,7 @@ import cycles_setup  # noqa: E402
 
 def build():
     # Samples and seed are set per bake (cycles_bake).
-    scene = cycles_setup.reset_scene(samples=1, seed=0, bounces=64)
-    cy = scene.cycles
-    cy.glossy_bounces = cy.transmission_bounces = cy.volume_bounces = cy.transparent_max_bounces = 0
-    meshes, light = room.build_room(scene)
-    made = {}
-    for o in meshes:
-        for slot in o.material_slots:
-            m = slot.material
-            if m.name not in made:
-                made[m.name] = cycles_setup.lambert_material(m.name + " Lambert", tuple(m.diffuse_color)[:3])
-            slot.material = made[m.name]
-    return scene, meshes, light
+    return cycles_setup.lambertian_room(samples=1, seed=0)
 
 
 def cycles_bake(floor, res, samples, seed):

@@ -59,3 +59,26 @@ def lambert_material(name: str, albedo=(1.0, 1.0, 1.0), emission=None):
         shader = add.outputs["Shader"]
     nt.links.new(shader, out.inputs["Surface"])
     return mat
+
+
+def lambertian_room(samples: int, seed: int):
+    """The demo room (scripts/room.py) in a fresh Cycles scene with 64 diffuse bounces and
+    no others, its materials replaced by pure Lambertian ones of the same colour (what
+    Penumbra models). Returns (scene, meshes, light)."""
+    import bpy
+
+    import room
+
+    scene = reset_scene(samples, seed, bounces=64)
+    cy = scene.cycles
+    cy.glossy_bounces = cy.transmission_bounces = cy.volume_bounces = cy.transparent_max_bounces = 0
+    meshes, light = room.build_room(scene)
+    made = {}
+    for o in meshes:
+        for slot in o.material_slots:
+            m = slot.material
+            if m.name not in made:
+                made[m.name] = lambert_material(m.name + " Lambert", tuple(m.diffuse_color)[:3])
+            slot.material = made[m.name]
+    bpy.context.view_layer.update()
+    return scene, meshes, light

@@ -30,20 +30,7 @@ TOL = 0.03
 
 
 def _build():
-    scene = cr.new_scene(samples=SAMPLES, seed=1)
-    cy = scene.cycles
-    cy.max_bounces = cy.diffuse_bounces = 64
-    cy.glossy_bounces = cy.transmission_bounces = cy.volume_bounces = cy.transparent_max_bounces = 0
-    meshes, light = room.build_room(scene)
-    lambert = {}
-    for o in meshes:
-        for slot in o.material_slots:
-            m = slot.material
-            if m.name not in lambert:
-                lambert[m.name] = cr.diffuse_material(m.name + " Lambert", tuple(m.diffuse_color)[:3])
-            slot.material = lambert[m.name]
-    bpy.context.view_layer.update()
-    return scene, meshes, light
+    return cr.cycles_setup.lambertian_room(SAMPLES, seed=1)
 
 
 def _cycles_image(floor, seed):
