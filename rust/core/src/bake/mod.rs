@@ -15,7 +15,7 @@ use serde::Serialize;
 use crate::direct;
 use crate::geom::raycast::Occluders;
 use crate::indirect;
-use crate::mesh::elements::{Elements, Region};
+use crate::mesh::elements::Elements;
 use crate::mesh::sizing::Sizing;
 use crate::mesh::{self, ReceiverMesh};
 use crate::regions::{self, ReceiverRegions, RegionTimes};
@@ -129,7 +129,7 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
     // indirect light follows: bounced light reaches the floor beside a box, never under it.
     let keep_contacts = scene.settings.indirect;
     let tol = scene.tolerances();
-    let (shadows, es) = shadows::shadow_polygons(scene, &tol, keep_contacts, progress)?;
+    let (shadows, es) = shadows::shadow_polygons(scene, &tol, progress)?;
     stats.T_sdw = es.t_sdw;
     stats.T_isr = es.t_isr;
     stats.shadow_pairs = es.shadow_pairs;
@@ -238,11 +238,7 @@ fn assemble(scene: &Scene, meshes: &[ReceiverMesh]) -> Elements {
         el.tri_face
             .extend(std::iter::repeat_n(fi as u32, m.triangles.len()));
         el.tri_region.extend(m.tri_region.iter().map(|r| r + r0));
-        el.regions.extend(m.regions.iter().map(|r| Region {
-            face: fi as u32,
-            relations: r.relations.clone(),
-            blockers: r.blockers.clone(),
-        }));
+        el.regions.extend(m.regions.iter().cloned());
     }
     el
 }

@@ -190,37 +190,78 @@ pub fn simplify_convex(poly: &[DVec2]) -> Vec<DVec2> {
     pts
 }
 
-/// The parameters `t0 < t1` along a–b (0 at a, 1 at b) of the part of segment a–b inside
-/// the counter-clockwise convex polygon `poly` (Cyrus–Beck), or `None` when nothing is.
-pub fn clip_segment_convex(a: DVec2, b: DVec2, poly: &[DVec2]) -> Option<(f64, f64)> {
+/// The one segment-against-convex clipper: the parameters `t0 < t1` along a–b (0 at a, 1 at
+/// b) of the part of segment a–b inside the counter-clockwise convex `poly` (Cyrus–Beck),
+/// or `None` when nothing is, or when no part lies at least `margin` inside every edge line.
+/// An edge line cuts the segment only when an end lies more than `slack` beyond it.
+///
+/// Callers differ only in these two distances:
+/// - `(0, 0)`: the exact part inside (critical lines in a penumbra, plane cuts in a receiver);
+/// - `(margin, 0)`: umbra pruning decides with a margin whether a segment runs deep inside a
+///   cover, then cuts it where it crosses the cover's edges, so that the pieces left end on
+///   those edges (the arrangement snaps them there) instead of leaving stubs inside;
+/// - `(0, snap)`: the arrangement, where a segment lying on the boundary up to rounding must
+///   survive whole, so that snapping puts it onto the boundary instead of losing it.
+///
+/// # Precision
+/// With both distances zero the decisions are scale-free and the edge-line values are used
+/// unscaled; otherwise they are divided by the edge's length to be compared with distances.
+pub fn clip_segment_convex(
+    a: DVec2,
+    b: DVec2,
+    poly: &[DVec2],
+    margin: f64,
+    slack: f64,
+) -> Option<(f64, f64)> {
+    let euclidean = margin != 0.0 || slack != 0.0;
+    if margin != 0.0 {
+        let deep = cyrus_beck(a, b, poly, margin, slack, euclidean)?;
+        return Some(cyrus_beck(a, b, poly, 0.0, slack, euclidean).unwrap_or(deep));
+    }
+    cyrus_beck(a, b, poly, 0.0, slack, euclidean)
+}
+
+/// The interval of a–b at least `margin` inside every edge line of `poly`, edges cutting
+/// only where an end lies more than `slack` beyond them; line values in lengths when
+/// `euclidean`, else unscaled.
+fn cyrus_beck(
+    a: DVec2,
+    b: DVec2,
+    poly: &[DVec2],
+    margin: f64,
+    slack: f64,
+    euclidean: bool,
+) -> Option<(f64, f64)> {
     let (mut t0, mut t1) = (0.0f64, 1.0f64);
     let d = b - a;
-    for i in 0..poly.len() {
-        let p = poly[i];
-        let e = poly[(i + 1) % poly.len()] - p;
+    let n = poly.len();
+    for i in 0..n {
+        let (p, q) = (poly[i], poly[(i + 1) % n]);
+        let e = q - p;
         if e == DVec2::ZERO {
             continue;
         }
-        // Inside is to the left of e; f0 how far a is inside, fd its rate along a–b.
-        let f0 = e.perp_dot(a - p);
-        let fd = e.perp_dot(d);
-        if fd == 0.0 {
-            if f0 < 0.0 {
-                return None;
-            }
-            continue;
-        }
-        let t = -f0 / fd;
-        if fd > 0.0 {
-            t0 = t0.max(t);
+        // f0 at a (positive inside the line moved in by margin), changing by fd to b.
+        let (f0, fd) = if euclidean {
+            let len = e.length();
+            (e.perp_dot(a - p) / len - margin, e.perp_dot(d) / len)
         } else {
-            t1 = t1.min(t);
-        }
-        if t0 >= t1 {
+            (e.perp_dot(a - p), e.perp_dot(d))
+        };
+        let (out_a, out_b) = (f0 < -slack, f0 + fd < -slack);
+        if out_a && out_b {
             return None;
         }
+        if out_a || out_b {
+            let t = -f0 / fd;
+            if out_a {
+                t0 = t0.max(t);
+            } else {
+                t1 = t1.min(t);
+            }
+        }
     }
-    Some((t0, t1))
+    (t0 < t1).then_some((t0, t1))
 }
 
 /// Distance from `p` to the segment a–b.
@@ -245,6 +286,30 @@ mod test {
             DVec2::new(1., 1.),
             DVec2::new(0., 1.),
         ]
+    }
+
+    #[test]
+    fn one_segment_clipper_exact_deep_and_forgiving() {
+        let (sq, p) = (square(), DVec2::new);
+        // Exact: the part inside, cut at the edges.
+        let (t0, t1) = clip_segment_convex(p(-1.0, 0.5), p(3.0, 0.5), &sq, 0.0, 0.0).unwrap();
+        assert_eq!((t0, t1), (0.25, 0.5));
+        assert!(clip_segment_convex(p(-1.0, 2.0), p(3.0, 2.0), &sq, 0.0, 0.0).is_none());
+        // Along an edge: on the line is inside.
+        assert_eq!(
+            clip_segment_convex(p(0.2, 0.0), p(0.8, 0.0), &sq, 0.0, 0.0),
+            Some((0.0, 1.0))
+        );
+        // Margin: near the edge is not deep; deep runs are still cut at the edges.
+        assert!(clip_segment_convex(p(-1.0, 0.1), p(3.0, 0.1), &sq, 0.2, 0.0).is_none());
+        let (t0, t1) = clip_segment_convex(p(-1.0, 0.5), p(3.0, 0.5), &sq, 0.2, 0.0).unwrap();
+        assert_eq!((t0, t1), (0.25, 0.5));
+        // Slack: a hair outside the bottom edge survives whole; farther out it is cut.
+        let below = |y| clip_segment_convex(p(0.2, y), p(0.8, y), &sq, 0.0, 1e-6);
+        assert_eq!(below(-1e-7), Some((0.0, 1.0)));
+        assert!(below(-1e-5).is_none());
+        let (t0, _) = clip_segment_convex(p(-0.5, 0.5), p(0.5, 0.5), &sq, 0.0, 1e-6).unwrap();
+        assert_eq!(t0, 0.5);
     }
 
     #[test]

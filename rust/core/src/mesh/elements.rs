@@ -4,7 +4,7 @@
 
 use glam::DVec3;
 
-use crate::regions::relation::Relation;
+use crate::regions::Region;
 
 #[derive(Debug, Clone, Default)]
 pub struct Elements {
@@ -22,16 +22,6 @@ pub struct Elements {
     /// Region (index into `regions`) of each triangle.
     pub tri_region: Vec<u32>,
     pub regions: Vec<Region>,
-}
-
-/// A face after the loop split: one relation per light, and for each light the occluder faces
-/// whose penumbra volume contains the region (the only ones that can hide part of that light
-/// from a point of the region).
-#[derive(Debug, Clone, Default)]
-pub struct Region {
-    pub face: u32,
-    pub relations: Vec<Relation>,
-    pub blockers: Vec<Vec<u32>>,
 }
 
 impl Elements {

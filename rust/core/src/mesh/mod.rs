@@ -23,7 +23,7 @@ use crate::geom::polygon::{orient, segment_distance as seg_dist};
 use crate::mesh::sizing::Sizing;
 use crate::regions::arrangement::ArrFace;
 use crate::regions::relation::Relation;
-use crate::regions::{ReceiverRegions, RegionFace};
+use crate::regions::{ReceiverRegions, Region};
 use crate::scene::settings::Settings;
 use crate::scene::Tolerances;
 use crate::BakeError;
@@ -37,7 +37,7 @@ pub struct ReceiverMesh {
     pub eval: Vec<DVec2>,
     pub triangles: Vec<[u32; 3]>,
     pub tri_region: Vec<u32>,
-    pub regions: Vec<RegionFace>,
+    pub regions: Vec<Region>,
 }
 
 type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
@@ -139,7 +139,7 @@ pub fn mesh_receiver(
     );
     if settings.uniform {
         let mut m = extract(&cdt, rr, sizing.frame(), true, tol);
-        m.regions = vec![rr.faces.first().cloned().unwrap_or(RegionFace {
+        m.regions = vec![rr.faces.first().cloned().unwrap_or(Region {
             relations: Vec::new(),
             blockers: Vec::new(),
         })];
@@ -354,7 +354,7 @@ fn extract(
         };
     }
     let mut comp = vec![u32::MAX; faces.len()];
-    let mut regions: Vec<RegionFace> = Vec::new();
+    let mut regions: Vec<Region> = Vec::new();
     for start in 0..faces.len() {
         if comp[start] != u32::MAX {
             continue;
@@ -387,7 +387,7 @@ fn extract(
 
     // D0 split: group the triangles around each vertex into sectors that do not cross a
     // lit|umbra edge; every sector but the first gets its own copy of the vertex.
-    let lit_umbra = |a: &RegionFace, b: &RegionFace| {
+    let lit_umbra = |a: &Region, b: &Region| {
         a.relations.iter().zip(&b.relations).any(|(x, y)| {
             matches!(
                 (x, y),

@@ -14,15 +14,17 @@ use crate::geom::polygon::inside_convex;
 use crate::geom::union_find::UnionFind;
 use crate::regions::relation::Relation;
 use crate::scene::{Face, Tolerances};
-use crate::shadows::umbra_pruning::UmbraCover;
+use crate::shadows::umbra_pruning::{trim_lines, UmbraCover};
 use crate::shadows::{Exposure, ReceiverShadows, ShadowPolygon};
 use arrangement::{Arrangement, Segment, BOUNDARY_TAG};
 
-/// A face of the arrangement with its light relations.
-#[derive(Debug, Clone)]
-pub struct RegionFace {
+/// A region (a face of the arrangement, or an element-mesh region): one relation per
+/// light, and for each light the occluders whose penumbra polygon contains the region (the
+/// only ones that can hide part of that light from a point of it). The receiver face it
+/// lies on is known where it is stored (`ReceiverRegions::face`, `Elements::tri_face`).
+#[derive(Debug, Clone, Default)]
+pub struct Region {
     pub relations: Vec<Relation>,
-    /// Per light: occluders whose penumbra polygon contains the face.
     pub blockers: Vec<Vec<u32>>,
 }
 
@@ -31,7 +33,7 @@ pub struct RegionFace {
 pub struct ReceiverRegions {
     pub face: u32,
     pub arrangement: Arrangement,
-    pub faces: Vec<RegionFace>,
+    pub faces: Vec<Region>,
     /// Arrangement edges kept as discontinuities (plus boundary edges).
     pub kept_edges: Vec<u32>,
     /// Discontinuity edges kept (boundary excluded): the paper's N_d.
@@ -48,7 +50,7 @@ pub struct ReceiverRegions {
 
 impl ReceiverRegions {
     /// Relation and blockers of the point `q` (strictly inside some region).
-    pub fn classify(&self, q: DVec2) -> RegionFace {
+    pub fn classify(&self, q: DVec2) -> Region {
         self.classifier.classify(q)
     }
 }
@@ -78,13 +80,13 @@ impl Classifier {
     }
 
     /// Relation and blockers of the point `q` (strictly inside some arrangement face).
-    fn classify(&self, q: DVec2) -> RegionFace {
+    fn classify(&self, q: DVec2) -> Region {
         let exposure = &self.exposure;
         let n = exposure.len();
         let mut relations = vec![Relation::Lit; n];
         let mut blockers = vec![Vec::new(); n];
         if self.inside.iter().any(|p| inside_convex(p, q)) {
-            return RegionFace {
+            return Region {
                 relations: vec![Relation::Umbra; n],
                 blockers,
             };
@@ -126,7 +128,7 @@ impl Classifier {
             b.sort_unstable();
             b.dedup();
         }
-        RegionFace {
+        Region {
             relations,
             blockers,
         }
@@ -142,11 +144,25 @@ pub struct RegionTimes {
 
 pub fn build_regions(
     r: &Face,
-    sh: ReceiverShadows,
+    mut sh: ReceiverShadows,
     tol: &Tolerances,
     uniform: bool,
     keep_contacts: bool,
 ) -> (ReceiverRegions, RegionTimes) {
+    let t0 = std::time::Instant::now();
+    let snap = tol.snap(r);
+    // Parts of edges deep inside an umbra of their own light would only be dropped again
+    // after the arrangement; a few snap distances keep rounding off the umbra boundaries.
+    // For a bake of direct light only, the one light reaching the receiver covers the lines
+    // of every light too (contacts need not stay: no bounced light jumps across them).
+    let cover = UmbraCover::new(
+        &sh.polys,
+        &sh.inside,
+        &sh.exposure,
+        8.0 * snap,
+        !keep_contacts,
+    );
+    trim_lines(&cover, &mut sh.plane_cuts, &mut sh.contacts, &mut sh.events);
     if uniform {
         return (
             uniform_regions(r, sh, tol),
@@ -158,12 +174,7 @@ pub fn build_regions(
             },
         );
     }
-    let t0 = std::time::Instant::now();
-    let snap = tol.snap(r);
-    // Parts of edges deep inside an umbra of their own light would only be dropped again
-    // after the arrangement; a few snap distances keep rounding off the umbra boundaries.
     // Every segment cut here carries its light, so the only-light rule never applies.
-    let cover = UmbraCover::new(&sh.polys, &sh.inside, &sh.exposure, 8.0 * snap, false);
     let (mut scratch, mut pieces) = (Vec::new(), Vec::new());
     let mut segs = Vec::new();
     for (k, p) in sh.polys.iter().enumerate() {
@@ -188,17 +199,16 @@ pub fn build_regions(
             }
         }
     }
+    drop(cover);
+    // Critical lines, plane cuts and contacts were trimmed above (`trim_lines`).
     let n_polys = sh.polys.len() as u32;
-    for (k, (l, [a, b])) in sh.events.iter().enumerate() {
-        pieces.clear();
-        cover.uncovered(*a, *b, Some(*l), None, &mut scratch, &mut pieces);
-        segs.extend(pieces.iter().map(|&(a, b)| Segment {
-            a,
-            b,
+    for (k, (_, [a, b])) in sh.events.iter().enumerate() {
+        segs.push(Segment {
+            a: *a,
+            b: *b,
             tag: n_polys + k as u32,
-        }));
+        });
     }
-    // Plane cuts were cut in `edges` already (`umbra_cover::trim_lines`).
     let n_events = sh.events.len() as u32;
     // Contacts too when indirect light follows: where a solid meets the receiver in umbra on
     // both sides, bounced light still reaches the side outside it and never the inside.
@@ -217,7 +227,7 @@ pub fn build_regions(
 
     let t2 = std::time::Instant::now();
     let classifier = Classifier::new(sh.polys, sh.inside, sh.exposure);
-    let faces: Vec<RegionFace> = arr
+    let faces: Vec<Region> = arr
         .faces
         .iter()
         .map(|f| classifier.classify(f.interior))
@@ -307,7 +317,7 @@ pub fn build_regions(
 fn uniform_regions(r: &Face, sh: ReceiverShadows, tol: &Tolerances) -> ReceiverRegions {
     let arr = arrangement::build(&r.poly2, &[], tol.snap(r));
     let n = sh.exposure.len();
-    let mut rf = RegionFace {
+    let mut rf = Region {
         relations: vec![Relation::Lit; n],
         blockers: vec![Vec::new(); n],
     };

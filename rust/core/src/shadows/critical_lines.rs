@@ -45,7 +45,7 @@ fn clip_height(r: &Face, a: DVec3, b: DVec3, limit: f64) -> Option<(DVec3, DVec3
 
 /// Clips a 2-D segment to a convex counter-clockwise polygon.
 fn clip_to_convex(p: DVec2, q: DVec2, poly: &[DVec2]) -> Option<(DVec2, DVec2)> {
-    let (t0, t1) = crate::geom::polygon::clip_segment_convex(p, q, poly)?;
+    let (t0, t1) = crate::geom::polygon::clip_segment_convex(p, q, poly, 0.0, 0.0)?;
     Some((p + (q - p) * t0, p + (q - p) * t1))
 }
 

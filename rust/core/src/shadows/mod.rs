@@ -104,7 +104,6 @@ fn occluder_outline(occ: &Occluder, faces: &[Face]) -> (Vec<DVec3>, Vec<[DVec3; 
 pub fn shadow_polygons(
     scene: &Scene,
     tol: &Tolerances,
-    keep_contacts: bool,
     progress: &crate::Progress,
 ) -> Result<(Vec<ReceiverShadows>, EdgeStats), crate::BakeError> {
     let eps = tol.eps;
@@ -232,13 +231,11 @@ pub fn shadow_polygons(
         stats.t_isr += t1.elapsed().as_secs_f64();
     }
     let t2 = std::time::Instant::now();
-    per_receiver.par_iter_mut().zip(faces).for_each(|(r, f)| {
+    per_receiver.par_iter_mut().for_each(|r| {
         if progress.is_cancelled() {
             return;
         }
         crate::shadows::umbra_pruning::drop_covered(&mut r.polys, &r.inside);
-        let snap = tol.snap(f);
-        crate::shadows::umbra_pruning::trim_lines(r, snap, !keep_contacts);
     });
     stats.t_isr += t2.elapsed().as_secs_f64();
     progress.check()?;

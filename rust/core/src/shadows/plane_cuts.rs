@@ -49,7 +49,7 @@ pub fn plane_cut(verts: &[DVec3], r: &Face, touch: f64) -> Option<[DVec2; 2]> {
 /// when less than `tol` of it is left.
 fn clip_segment_convex(a: DVec2, b: DVec2, poly: &[DVec2], tol: f64) -> Option<[DVec2; 2]> {
     let d = b - a;
-    let (t0, t1) = crate::geom::polygon::clip_segment_convex(a, b, poly)?;
+    let (t0, t1) = crate::geom::polygon::clip_segment_convex(a, b, poly, 0.0, 0.0)?;
     ((t1 - t0) * d.length() > tol).then(|| [a + d * t0, a + d * t1])
 }
 

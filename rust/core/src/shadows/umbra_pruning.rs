@@ -22,8 +22,8 @@
 use glam::DVec2;
 
 use crate::geom::box_grid::{bounds, BoxGrid};
-use crate::geom::polygon::{inside_convex, signed_area_2d};
-use crate::shadows::polygons::{Exposure, ReceiverShadows, ShadowPolygon};
+use crate::geom::polygon::{clip_segment_convex, inside_convex, signed_area_2d};
+use crate::shadows::polygons::{Exposure, ShadowPolygon};
 
 /// Removes from `polys` every polygon that lies inside another (kept) umbra polygon of the
 /// same light, or inside one of `inside` (parts of the receiver inside solids). Of several
@@ -83,14 +83,17 @@ pub fn drop_covered(polys: &mut Vec<ShadowPolygon>, inside: &[Vec<DVec2>]) {
 }
 
 /// Cuts the lines that belong to every light on one receiver (plane cuts, contacts) where
-/// they lie deep inside a part covered for every light (see `UmbraCover`), and critical
-/// lines where they lie deep inside an umbra of their light. `snap` is the arrangement's
-/// snapping distance on this receiver; `direct_only`: contacts and plane cuts need not stay (no indirect light follows).
-pub fn trim_lines(sh: &mut ReceiverShadows, snap: f64, direct_only: bool) {
-    if sh.inside.is_empty() && sh.polys.is_empty() {
+/// they lie deep inside a part `cover` covers for every light, and critical lines where they
+/// lie deep inside an umbra of their light. `sh` must be the receiver `cover` was built from.
+pub fn trim_lines(
+    cover: &UmbraCover,
+    plane_cuts: &mut Vec<[DVec2; 2]>,
+    contacts: &mut Vec<[DVec2; 2]>,
+    events: &mut Vec<(u32, [DVec2; 2])>,
+) {
+    if cover.covers.is_empty() {
         return;
     }
-    let cover = UmbraCover::new(&sh.polys, &sh.inside, &sh.exposure, 8.0 * snap, direct_only);
     let (mut scratch, mut pieces) = (Vec::new(), Vec::new());
     let mut cut = |lines: &[[DVec2; 2]], light: Option<u32>| -> Vec<[DVec2; 2]> {
         let mut out = Vec::with_capacity(lines.len());
@@ -101,19 +104,21 @@ pub fn trim_lines(sh: &mut ReceiverShadows, snap: f64, direct_only: bool) {
         }
         out
     };
-    let plane_cuts = cut(&sh.plane_cuts, None);
-    let contacts = cut(&sh.contacts, None);
-    let mut events = Vec::with_capacity(sh.events.len());
-    for &(l, e) in &sh.events {
-        events.extend(cut(&[e], Some(l)).into_iter().map(|e| (l, e)));
+    *plane_cuts = cut(plane_cuts, None);
+    *contacts = cut(contacts, None);
+    let mut trimmed = Vec::with_capacity(events.len());
+    for &(l, e) in events.iter() {
+        trimmed.extend(cut(&[e], Some(l)).into_iter().map(|e| (l, e)));
     }
-    sh.plane_cuts = plane_cuts;
-    sh.contacts = contacts;
-    sh.events = events;
+    *events = trimmed;
 }
 
 /// The covers of one receiver, for cutting segments: the umbra polygons of each light, and
-/// the parts inside solids, which cover for every light.
+/// the parts inside solids, which cover for every light. Built once per receiver by the
+/// region stage, which cuts with it first the lines of every light (`trim_lines`: plane
+/// cuts, contacts, critical lines), then the shadow polygons' edges. One rule serves both:
+/// `only_light` decides only for lines that belong to every light, and the polygon edges
+/// always name their light.
 pub struct UmbraCover<'a> {
     /// Polygon, the light it covers (`None`: every light) and the shadow polygon it is.
     covers: Vec<(&'a [DVec2], Option<u32>, Option<u32>)>,
@@ -188,8 +193,8 @@ impl<'a> UmbraCover<'a> {
             // Decided with the margin, cut where the segment crosses the boundary: the
             // pieces left then end on the cover's edges (the arrangement snaps them there)
             // instead of leaving stubs inside that would stay as dangling edges.
-            if let Some(deep) = deep_inside(q, a, d, self.margin) {
-                cut.push(deep_inside(q, a, d, 0.0).unwrap_or(deep));
+            if let Some(deep) = clip_segment_convex(a, b, q, self.margin, 0.0) {
+                cut.push(deep);
             }
         }
         if cut.is_empty() {
@@ -209,40 +214,6 @@ impl<'a> UmbraCover<'a> {
             out.push((at(t), b));
         }
     }
-}
-
-/// The parameter interval of `a + t·d`, t in [0, 1], that lies farther than `margin` inside
-/// every edge line of convex counter-clockwise `poly`, if not empty.
-fn deep_inside(poly: &[DVec2], a: DVec2, d: DVec2, margin: f64) -> Option<(f64, f64)> {
-    let (mut t0, mut t1) = (0.0f64, 1.0f64);
-    let n = poly.len();
-    for i in 0..n {
-        let (p, q) = (poly[i], poly[(i + 1) % n]);
-        let e = q - p;
-        let len = e.length();
-        if !(len > 0.0) {
-            continue;
-        }
-        // Signed distance inside the edge line at t: f0 + t·df.
-        let f0 = e.perp_dot(a - p) / len - margin;
-        let df = e.perp_dot(d) / len;
-        if df == 0.0 {
-            if !(f0 > 0.0) {
-                return None;
-            }
-        } else {
-            let t = -f0 / df;
-            if df > 0.0 {
-                t0 = t0.max(t);
-            } else {
-                t1 = t1.min(t);
-            }
-        }
-        if !(t0 < t1) {
-            return None;
-        }
-    }
-    Some((t0, t1))
 }
 
 #[cfg(test)]

@@ -258,30 +258,7 @@ fn clip_to_convex(poly: &[DVec2], a: DVec2, b: DVec2, snap: f64) -> Option<(DVec
     if !sane(a) || !sane(b) {
         return None;
     }
-    let (mut t0, mut t1) = (0.0f64, 1.0f64);
-    let n = poly.len();
-    for i in 0..n {
-        let (p, q) = (poly[i], poly[(i + 1) % n]);
-        let len = (q - p).length();
-        // Signed distances (positive inside) to the edge line.
-        let da = (q - p).perp_dot(a - p) / len;
-        let db = (q - p).perp_dot(b - p) / len;
-        let (out_a, out_b) = (da < -snap, db < -snap);
-        if out_a && out_b {
-            return None;
-        }
-        if out_a || out_b {
-            let t = da / (da - db);
-            if out_a {
-                t0 = t0.max(t);
-            } else {
-                t1 = t1.min(t);
-            }
-        }
-    }
-    if t0 >= t1 {
-        return None;
-    }
+    let (t0, t1) = crate::geom::polygon::clip_segment_convex(a, b, poly, 0.0, snap)?;
     let pa = if t0 > 0.0 { a + (b - a) * t0 } else { a };
     let pb = if t1 < 1.0 { a + (b - a) * t1 } else { b };
     let (pa, pb) = (onto_boundary(poly, pa), onto_boundary(poly, pb));
