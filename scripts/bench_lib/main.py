@@ -20,7 +20,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.dirname(HERE))
 
-from bench_lib import errors, penumbra_job, probes, report  # noqa: E402
+from bench_lib import errors, lightmap, penumbra_job, probes, report  # noqa: E402
 
 # Full scenes compared with Cycles (built-in scenes of the CLI). room-78 is the scaling
 # room with 78 boxes of clutter (60 + 12·78 = 996 furniture triangles).
@@ -46,6 +46,10 @@ class Config:
         self.scenes = SCENES[:4] if quick else SCENES
         self.render_res = 120 if quick else 200
         self.render_samples = 32 if quick else 128
+        # Lightmap rows: texels on a side, Cycles' reference samples (× 2 seeds) and ladder.
+        self.lightmap_resolution = 64 if quick else 128
+        self.lightmap_ref_samples = 256 if quick else 1024
+        self.lightmap_ladder = [16, 64, 256] if quick else [16, 64, 256, 1024]
 
 
 def machine():
@@ -334,6 +338,9 @@ def main():
     ap.add_argument("--exe", default=os.path.join(ROOT, "target", "release", "penumbra"))
     ap.add_argument("--no-scaling", action="store_true",
                     help="skip the scaling series (room-N bakes of growing size)")
+    ap.add_argument("--lightmap-only", action="store_true",
+                    help="only the lightmap rows (Penumbra against Cycles' bake to an image); "
+                    "writes OUT/lightmaps.json and their section of OUT/results.md and README.md")
     a = ap.parse_args()
     if a.report_only:
         with open(os.path.join(a.out, "results.json")) as f:
@@ -349,10 +356,18 @@ def main():
     os.makedirs(a.work, exist_ok=True)
     os.makedirs(a.out, exist_ok=True)
     t0 = time.perf_counter()
-    res = dict(machine=machine(), quick=a.quick, config=vars(cfg),
-               command="scripts/bench" + (" --quick" if a.quick else ""), scenes={})
+    command = "scripts/bench" + (" --quick" if a.quick else "")
+    if a.lightmap_only:
+        command += " --lightmap-only" + (f" --scenes {' '.join(a.scenes)}" if a.scenes != cfg.scenes
+                                         else "")
+        rows = [lightmap.bench_scene(n, a.exe, sys.executable, a.work, cfg) for n in a.scenes]
+        write_lightmaps(rows, machine(), command, a.out)
+        return
+    res = dict(machine=machine(), quick=a.quick, config=vars(cfg), command=command, scenes={})
+    res["lightmaps"] = []
     for name in a.scenes:
         bench_scene(name, a.exe, sys.executable, a.work, cfg, res["scenes"])
+        res["lightmaps"].append(lightmap.bench_scene(name, a.exe, sys.executable, a.work, cfg))
     res["scaling"] = [] if a.no_scaling else scaling(a.exe, a.work, cfg)
     res["profile"] = profile(a.exe, a.work, a.scenes[-1])
     if "cornell" in a.scenes:
@@ -361,6 +376,22 @@ def main():
     with open(os.path.join(a.out, "results.json"), "w") as f:
         json.dump(res, f, indent=1, default=float)
     text = report.write(res, a.out)
+    print(text)
+    write_lightmaps(res["lightmaps"], res["machine"], command, a.out)
+
+
+def write_lightmaps(rows, mach, command, out):
+    """The lightmap rows: OUT/lightmaps.json, and their section in OUT/results.md and (for
+    the repository's own bench/) README.md."""
+    with open(os.path.join(out, "lightmaps.json"), "w") as f:
+        json.dump(dict(machine=mach, command=command, scenes=rows), f, indent=1, default=float)
+    text = lightmap.section(rows, mach, command)
+    md = os.path.join(out, "results.md")
+    if not os.path.exists(md):
+        open(md, "w").close()
+    lightmap.splice(md, text)
+    if os.path.abspath(out) == os.path.join(ROOT, "bench"):
+        lightmap.splice(os.path.join(ROOT, "README.md"), text)
     print(text)
 
 
