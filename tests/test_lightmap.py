@@ -93,23 +93,29 @@ def test_an_existing_lightmap_uv_map_is_used_as_it_is(room_scene, empty):
     assert px[0, 0].max() == 0.0 and px[RES - 1, RES - 1].max() == 0.0
 
 
-def test_both_with_preview_changes_only_the_preview_nodes(room_scene, empty):
+def test_both_with_preview_leaves_the_users_materials_alone(room_scene, empty):
     _lightmap_settings(empty.scene, output="BOTH")
     empty.scene.penumbra.lightmap_preview = True
     mat = bpy.data.materials["Room White"]
     links_before = {(l.from_node.name, l.to_node.name) for l in mat.node_tree.links}
+    nodes_before = sorted(n.name for n in mat.node_tree.nodes)
     assert bake_blocking(empty, Reports()) == {"FINISHED"}
     assert bpy.data.objects.get("Floor_baked") is not None
-    names = [n.name for n in mat.node_tree.nodes if n.name.startswith(PREFIX)]
+    floor = bpy.data.objects["Floor"]
+    shown = floor.material_slots[0].material
+    assert shown != mat and floor.material_slots[0].link == "OBJECT"
+    assert floor.data.materials[0] == mat
+    names = [n.name for n in shown.node_tree.nodes if n.name.startswith(PREFIX)]
     assert len(names) == 2  # UV map + image; emission shows the lightmap without Lighting Only
-    links_after = {(l.from_node.name, l.to_node.name) for l in mat.node_tree.links}
-    assert links_before <= links_after
-    assert all(PREFIX in a or PREFIX in b for a, b in links_after - links_before)
+    assert sorted(n.name for n in mat.node_tree.nodes) == nodes_before
+    assert {(l.from_node.name, l.to_node.name) for l in mat.node_tree.links} == links_before
     # Previewing again replaces, never stacks.
     empty.scene.penumbra.lighting_only = True
     assert bake_blocking(empty, Reports()) == {"FINISHED"}
-    names = [n.name for n in mat.node_tree.nodes if n.name.startswith(PREFIX)]
+    shown = floor.material_slots[0].material
+    names = [n.name for n in shown.node_tree.nodes if n.name.startswith(PREFIX)]
     assert len(names) == 3  # UV map, image, multiply
+    assert not [m for m in bpy.data.materials if m.name.startswith("Room White (") and m.users == 0]
 
 
 def test_images_are_saved_beside_a_saved_blend(room_scene, empty, tmp_path):

@@ -1,20 +1,74 @@
-"""Optional preview of a lightmap on the original object's own materials.
+"""Optional preview of a lightmap on the original objects.
 
 With Lighting Only the lightmap holds E/π, so the preview multiplies each Principled BSDF's
 Base Color by it; otherwise the lightmap holds the full outgoing radiance and is shown as
-the BSDF's emission (strength 1). The nodes added are named ``Penumbra Lightmap …`` and are
-replaced by the next preview, so previews do not pile up; nothing else in the material
-changes. A material shared with another baked object shows the lightmap of the last one.
+the BSDF's emission (strength 1).
+
+Each previewed object gets its own copies of its materials, linked to the object
+(``slot.link = 'OBJECT'``), so that objects sharing a material each show their own lightmap
+while the user's materials and meshes stay as they were. ``hide`` (turning the preview off,
+or the next preview) links the slots back as they were and deletes the copies. The nodes
+added are named ``Penumbra Lightmap …``.
 """
 
 from .export import LIGHTMAP_UV
 
 PREFIX = "Penumbra Lightmap"
+# On a preview copy: the slot link and object-level material it stands in for.
+_LINK = "penumbra_preview_link"
+_WAS = "penumbra_preview_was"
+
+
+def show(obj, image, lighting_only):
+    """Shows ``image`` on ``obj`` through object-linked copies of its materials that have a
+    Principled BSDF (an earlier preview of ``obj`` is taken out first); returns the number
+    of materials previewed."""
+    hide(obj)
+    for slot in obj.material_slots:
+        mat = slot.material
+        if mat is None or mat.node_tree is None:
+            continue
+        if not any(n.type == "BSDF_PRINCIPLED" for n in mat.node_tree.nodes):
+            continue
+        copy = mat.copy()
+        copy.name = "%s (%s %s)" % (mat.name, PREFIX, obj.name)
+        copy[_LINK] = slot.link
+        if slot.link == "OBJECT":
+            copy[_WAS] = mat
+        slot.link = "OBJECT"
+        slot.material = copy
+    return apply(obj, image, lighting_only)
+
+
+def hide(obj):
+    """Takes ``obj``'s preview out: slots linked back as they were, copies deleted."""
+    import bpy
+
+    copies = []
+    for slot in obj.material_slots:
+        mat = slot.link == "OBJECT" and slot.material
+        if not mat or _LINK not in mat:
+            continue
+        if mat[_LINK] == "OBJECT":
+            slot.material = mat.get(_WAS)
+        else:
+            slot.link = "DATA"
+        copies.append(mat)
+    for mat in copies:
+        if mat.name in bpy.data.materials:
+            bpy.data.materials.remove(mat)
+    return len(copies)
+
+
+def hide_all(objects):
+    """``hide`` on every object; returns the number of materials restored."""
+    return sum(hide(obj) for obj in objects if obj.type == "MESH")
 
 
 def apply(obj, image, lighting_only):
-    """Adds the preview to every material of ``obj`` that has a Principled BSDF; returns the
-    number of materials changed."""
+    """Adds the preview nodes to every material of ``obj`` that has a Principled BSDF, in
+    place (``show`` and the glTF export call it on copies); returns the number of materials
+    changed."""
     changed = 0
     for slot in obj.material_slots:
         mat = slot.material

@@ -90,7 +90,7 @@ def finish(context, export, result, seconds, report):
     images = lightmaps.store(maps)
     if settings.lightmap_preview:
         for (_, source), image in zip(pairs, images):
-            lightmap_preview.apply(source, image, settings.lighting_only)
+            lightmap_preview.show(source, image, settings.lighting_only)
 
     stats = result["stats"]
     elements = stats.get("N_e") or sum(len(m["triangles"]) for m in result["meshes"])

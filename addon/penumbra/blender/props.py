@@ -4,6 +4,21 @@ import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 
 
+def _preview_changed(settings, context):
+    """Turning the preview on shows each object's existing lightmap; off restores every
+    previewed object's materials."""
+    from . import lightmap_preview
+    from .lightmaps import IMAGE_SUFFIX
+
+    objects = [o for o in context.scene.objects if o.type == "MESH"]
+    if not settings.lightmap_preview:
+        lightmap_preview.hide_all(objects)
+        return
+    for obj in objects:
+        image = bpy.data.images.get(obj.name + IMAGE_SUFFIX)
+        if image is not None:
+            lightmap_preview.show(obj, image, settings.lighting_only)
+
 
 class PenumbraSettings(bpy.types.PropertyGroup):
     quality: EnumProperty(
@@ -92,9 +107,11 @@ class PenumbraSettings(bpy.types.PropertyGroup):
         name="Preview on Originals",
         description=(
             "Show the lightmap on the original objects' materials: base colour × lightmap with "
-            "Lighting Only, else the lightmap as emission"
+            "Lighting Only, else the lightmap as emission (each object through its own copies "
+            "of its materials; off restores them)"
         ),
         default=False,
+        update=_preview_changed,
     )
     # Written by the last successful bake, read by the panel and by scripts.
     last_summary: StringProperty(name="Last Bake", default="")
