@@ -138,17 +138,18 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
     progress.stage("discontinuity loops");
     progress.check()?;
     let t = Instant::now();
-    // `None` once cancelled: rayon stops handing out receivers.
+    // The first `Cancelled` stops rayon handing out receivers; a large receiver's
+    // arrangement checks on its own.
     let built: Vec<(ReceiverRegions, RegionTimes)> = scene
         .faces
         .par_iter()
         .zip(shadows)
         .map(|(f, sh)| {
-            (!progress.is_cancelled())
-                .then(|| regions::build_regions(f, sh, &tol, scene.settings.uniform, keep_contacts))
+            progress.check()?;
+            let uniform = scene.settings.uniform;
+            regions::build_regions(f, sh, &tol, uniform, keep_contacts, progress)
         })
-        .collect::<Option<_>>()
-        .ok_or(BakeError::Cancelled)?;
+        .collect::<Result<_, BakeError>>()?;
     // Stage times are wall time, split between sub-stages by their share of CPU time.
     let wall = t.elapsed().as_secs_f64();
     let parts = built.iter().fold([0.0; 4], |a, (_, t)| {

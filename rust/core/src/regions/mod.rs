@@ -16,6 +16,7 @@ use crate::regions::relation::Relation;
 use crate::scene::{Face, Tolerances};
 use crate::shadows::umbra_pruning::{trim_lines, UmbraCover};
 use crate::shadows::{Exposure, ReceiverShadows, ShadowPolygon};
+use crate::{BakeError, Progress};
 use arrangement::{Arrangement, Segment, BOUNDARY_TAG};
 
 /// A region (a face of the arrangement, or an element-mesh region): one relation per
@@ -148,7 +149,8 @@ pub fn build_regions(
     tol: &Tolerances,
     uniform: bool,
     keep_contacts: bool,
-) -> (ReceiverRegions, RegionTimes) {
+    progress: &Progress,
+) -> Result<(ReceiverRegions, RegionTimes), BakeError> {
     let t0 = std::time::Instant::now();
     let snap = tol.snap(r);
     // Parts of edges deep inside an umbra of their own light would only be dropped again
@@ -164,7 +166,7 @@ pub fn build_regions(
     );
     trim_lines(&cover, &mut sh.plane_cuts, &mut sh.contacts, &mut sh.events);
     if uniform {
-        return (
+        return Ok((
             uniform_regions(r, sh, tol),
             RegionTimes {
                 t_idd: 0.0,
@@ -172,12 +174,15 @@ pub fn build_regions(
                 t_lit: 0.0,
                 t_div: 0.0,
             },
-        );
+        ));
     }
     // Every segment cut here carries its light, so the only-light rule never applies.
     let (mut scratch, mut pieces) = (Vec::new(), Vec::new());
     let mut segs = Vec::new();
     for (k, p) in sh.polys.iter().enumerate() {
+        if k % 1024 == 0 {
+            progress.check()?;
+        }
         for i in 0..p.poly.len() {
             let a = p.poly[i];
             let b = p.poly[(i + 1) % p.poly.len()];
@@ -222,16 +227,18 @@ pub fn build_regions(
     }
     let t_idd = t0.elapsed().as_secs_f64();
     let t1 = std::time::Instant::now();
-    let arr = arrangement::build(&r.poly2, &segs, snap);
+    let arr = arrangement::build_cancellable(&r.poly2, &segs, snap, progress)?;
     let t_lop = t1.elapsed().as_secs_f64();
 
     let t2 = std::time::Instant::now();
     let classifier = Classifier::new(sh.polys, sh.inside, sh.exposure);
-    let faces: Vec<Region> = arr
-        .faces
-        .iter()
-        .map(|f| classifier.classify(f.interior))
-        .collect();
+    let mut faces: Vec<Region> = Vec::with_capacity(arr.faces.len());
+    for (k, f) in arr.faces.iter().enumerate() {
+        if k % 4096 == 0 {
+            progress.check()?;
+        }
+        faces.push(classifier.classify(f.interior));
+    }
     let t_lit = t2.elapsed().as_secs_f64();
 
     let t3 = std::time::Instant::now();
@@ -291,7 +298,7 @@ pub fn build_regions(
     }
     let n_regions = merged.count_sets() as u64;
     let t_div = t3.elapsed().as_secs_f64();
-    (
+    Ok((
         ReceiverRegions {
             face: sh.face,
             arrangement: arr,
@@ -308,7 +315,7 @@ pub fn build_regions(
             t_lit,
             t_div,
         },
-    )
+    ))
 }
 
 /// The whole receiver as one region, for uniform meshing: every light that reaches it is

@@ -31,6 +31,7 @@ mod test;
 use glam::DVec2;
 
 use crate::geom::polygon::orient;
+use crate::{BakeError, Progress};
 
 /// A discontinuity edge on the receiver, in the receiver's 2-D frame. `tag` is the caller's id
 /// (it is carried to the output edges that lie on this segment).
@@ -145,8 +146,19 @@ impl Arrangement {
 /// assert!((arr.faces[0].area - 0.5).abs() < 1e-12);
 /// ```
 pub fn build(boundary: &[DVec2], segments: &[Segment], snap: f64) -> Arrangement {
+    build_cancellable(boundary, segments, snap, &Progress::new()).unwrap_or_default()
+}
+
+/// `build`, checking `progress` every few thousand units of work (edge pairs, vertices,
+/// loops), so that one huge receiver still returns `Cancelled` promptly.
+pub fn build_cancellable(
+    boundary: &[DVec2],
+    segments: &[Segment],
+    snap: f64,
+    progress: &Progress,
+) -> Result<Arrangement, BakeError> {
     let Some(boundary) = clean_boundary(boundary) else {
-        return Arrangement::default();
+        return Ok(Arrangement::default());
     };
     let snap = if snap.is_finite() && snap > 0.0 {
         snap
@@ -162,7 +174,7 @@ pub fn build(boundary: &[DVec2], segments: &[Segment], snap: f64) -> Arrangement
     // Beyond these, products of coordinate differences overflow or underflow and the exact
     // predicates lose their guarantee.
     if extent > MAX_COORD || diameter < MIN_DIAMETER {
-        return Arrangement::default();
+        return Ok(Arrangement::default());
     }
     let mut pool = snap::VertexPool::new(snap, extent);
 
@@ -174,7 +186,10 @@ pub fn build(boundary: &[DVec2], segments: &[Segment], snap: f64) -> Arrangement
             raw.push(split::Edge::new(a, b, BOUNDARY_TAG));
         }
     }
-    for s in segments {
+    for (k, s) in segments.iter().enumerate() {
+        if k % CHECK_EVERY == 0 {
+            progress.check()?;
+        }
         let Some((a, b)) = clip_to_convex(&boundary, s.a, s.b, snap) else {
             continue;
         };
@@ -184,15 +199,19 @@ pub fn build(boundary: &[DVec2], segments: &[Segment], snap: f64) -> Arrangement
         }
     }
 
-    let edges = split::split_all(&mut pool, raw, snap);
+    let edges = split::split_all(&mut pool, raw, snap, progress)?;
     let (vertices, edges) = drop_unused(pool.into_points(), edges);
-    let faces = trace::faces(&vertices, &edges);
-    Arrangement {
+    let faces = trace::faces(&vertices, &edges, progress)?;
+    Ok(Arrangement {
         vertices,
         edges,
         faces,
-    }
+    })
 }
+
+/// Units of work (segments, edge pairs, vertices, loops) between two cancel checks: a few
+/// milliseconds at most.
+const CHECK_EVERY: usize = 4096;
 
 /// Removes the vertices no edge uses (ends of dropped zero-length segments), keeping order.
 fn drop_unused(points: Vec<DVec2>, edges: Vec<split::Edge>) -> (Vec<DVec2>, Vec<ArrEdge>) {

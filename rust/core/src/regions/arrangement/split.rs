@@ -10,8 +10,10 @@ use std::collections::HashMap;
 use glam::DVec2;
 
 use super::snap::VertexPool;
+use super::CHECK_EVERY;
 use crate::geom::polygon::orient;
 use crate::geom::union_find::UnionFind;
+use crate::{BakeError, Progress};
 
 /// Snapping a crossing point moves an edge by up to `snap`, which can make it meet an edge
 /// it did not meet before; each round fixes those. Ordinary inputs settle in one or two
@@ -39,18 +41,28 @@ impl Edge {
 }
 
 /// Splits and merges until no pair of edges crosses, touches in an interior point or overlaps.
-pub(super) fn split_all(pool: &mut VertexPool, edges: Vec<Edge>, snap: f64) -> Vec<Edge> {
+pub(super) fn split_all(
+    pool: &mut VertexPool,
+    edges: Vec<Edge>,
+    snap: f64,
+    progress: &Progress,
+) -> Result<Vec<Edge>, BakeError> {
     let mut edges = merge(edges);
     // Vertices merged into others; the older vertex represents the set, so the receiver
     // corners, inserted first, never move.
     let mut alias = UnionFind::default();
     for _ in 0..MAX_ROUNDS {
+        progress.check()?;
         let pairs = candidate_pairs(pool.points(), &edges, snap);
+        progress.check()?;
         let mut found = Found {
             splits: vec![Vec::new(); edges.len()],
             merges: Vec::new(),
         };
-        for (i, j) in pairs {
+        for (k, (i, j)) in pairs.into_iter().enumerate() {
+            if k % CHECK_EVERY == 0 {
+                progress.check()?;
+            }
             intersect_pair(
                 pool,
                 &alias,
@@ -82,7 +94,7 @@ pub(super) fn split_all(pool: &mut VertexPool, edges: Vec<Edge>, snap: f64) -> V
         }
         edges = apply_splits(pool.points(), edges, &found.splits);
     }
-    edges
+    Ok(edges)
 }
 
 /// What one round of pair tests asks for.

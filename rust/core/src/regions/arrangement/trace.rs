@@ -8,9 +8,10 @@ use std::cmp::Ordering;
 
 use glam::DVec2;
 
-use super::{interior, winding, ArrEdge, ArrFace};
+use super::{interior, winding, ArrEdge, ArrFace, CHECK_EVERY};
 use crate::geom::polygon::orient;
 use crate::geom::union_find::UnionFind;
+use crate::{BakeError, Progress};
 
 /// Half-edge `h` runs along edge `h / 2`, from `v[0]` to `v[1]` when `h` is even.
 #[inline]
@@ -82,8 +83,12 @@ struct Loop {
 }
 
 /// The bounded faces of a planar graph whose edges meet only at shared end vertices.
-pub(super) fn faces(pts: &[DVec2], edges: &[ArrEdge]) -> Vec<ArrFace> {
-    let loops = trace_loops(pts, edges);
+pub(super) fn faces(
+    pts: &[DVec2],
+    edges: &[ArrEdge],
+    progress: &Progress,
+) -> Result<Vec<ArrFace>, BakeError> {
+    let loops = trace_loops(pts, edges, progress)?;
     let comp = components(pts.len(), edges);
 
     let outer: Vec<usize> = (0..loops.len())
@@ -98,6 +103,10 @@ pub(super) fn faces(pts: &[DVec2], edges: &[ArrEdge]) -> Vec<ArrFace> {
     // around it; components are disjoint, so any one vertex of the hole decides.
     let mut members: Vec<Vec<usize>> = vec![Vec::new(); outer.len()];
     for (li, l) in loops.iter().enumerate() {
+        // Each hole is tested against every outer loop around it.
+        if li % (CHECK_EVERY / 16) == 0 {
+            progress.check()?;
+        }
         if l.kind == Kind::Outer {
             continue;
         }
@@ -129,6 +138,9 @@ pub(super) fn faces(pts: &[DVec2], edges: &[ArrEdge]) -> Vec<ArrFace> {
 
     let mut out = Vec::with_capacity(outer.len());
     for (oi, &ol) in outer.iter().enumerate() {
+        if oi % CHECK_EVERY == 0 {
+            progress.check()?;
+        }
         let o = &loops[ol];
         let mut area = o.area;
         let mut holes = Vec::new();
@@ -153,7 +165,7 @@ pub(super) fn faces(pts: &[DVec2], edges: &[ArrEdge]) -> Vec<ArrFace> {
             boundary_edges,
         });
     }
-    out
+    Ok(out)
 }
 
 #[inline]
@@ -161,7 +173,11 @@ fn half_edge(edges: &[ArrEdge], h: u32) -> (u32, u32) {
     (origin(edges, h), dest(edges, h))
 }
 
-fn trace_loops(pts: &[DVec2], edges: &[ArrEdge]) -> Vec<Loop> {
+fn trace_loops(
+    pts: &[DVec2],
+    edges: &[ArrEdge],
+    progress: &Progress,
+) -> Result<Vec<Loop>, BakeError> {
     let nh = edges.len() * 2;
     // Outgoing half-edges of every vertex, counter-clockwise: those of vertex v are
     // `around[first[v]..first[v + 1]]`.
@@ -181,6 +197,9 @@ fn trace_loops(pts: &[DVec2], edges: &[ArrEdge]) -> Vec<Loop> {
     }
     let mut slot = vec![0u32; nh];
     for (v, &c) in pts.iter().enumerate() {
+        if v % CHECK_EVERY == 0 {
+            progress.check()?;
+        }
         let hs = &mut around[first[v]..first[v + 1]];
         let to = |h: u32| pts[dest(edges, h) as usize];
         // A rounded key sorts nearly right, and insertion with the exact comparison then
@@ -213,6 +232,9 @@ fn trace_loops(pts: &[DVec2], edges: &[ArrEdge]) -> Vec<Loop> {
     let mut walked = vec![false; nh];
     let mut loops = Vec::new();
     for start in 0..nh as u32 {
+        if start as usize % CHECK_EVERY == 0 {
+            progress.check()?;
+        }
         if walked[start as usize] {
             continue;
         }
@@ -233,7 +255,7 @@ fn trace_loops(pts: &[DVec2], edges: &[ArrEdge]) -> Vec<Loop> {
             area,
         });
     }
-    loops
+    Ok(loops)
 }
 
 /// Removes every half-edge immediately followed by its twin, cyclically (free reduction).
