@@ -3,9 +3,9 @@ to an image at a ladder of samples per texel, on the same "Lightmap" UVs (Blende
 Lightmap Pack, as the add-on makes them) and resolution, margin 0.
 
 Both are scored against a reference of two Cycles bakes with different seeds whose own noise
-is taken out (errors.py), over the texels whose 3×3 neighbourhood is covered in both
-references (a texel on an island's rim holds a partial footprint in Penumbra and the value
-at its centre's face in Cycles). Penumbra's time is the CLI's whole bake (every object's
+is taken out (errors.py), over the texels whose square lies wholly in one UV polygon (a
+texel on an island's rim holds the mean over a partial footprint, or over two faces, in
+Penumbra and the value at its centre in Cycles). Penumbra's time is the CLI's whole bake (every object's
 light is needed for the indirect light) plus all lightmaps; Cycles' is one bake call of
 every mesh into its image.
 """
@@ -45,16 +45,32 @@ def _load(path, n):
         return [z[f"m{i}"] for i in range(n)]
 
 
-def _interior(a, b):
-    """Texels baked in both references whose 3×3 neighbourhood is baked too."""
-    baked = (a[:, :, 0] >= 0) & (b[:, :, 0] >= 0)
-    keep = np.zeros_like(baked)
-    r = baked.shape[0]
-    inner = baked[1:-1, 1:-1].copy()
-    for dj in (-1, 0, 1):
-        for di in (-1, 0, 1):
-            inner &= baked[1 + dj: r - 1 + dj, 1 + di: r - 1 + di]
-    keep[1:-1, 1:-1] = inner
+def _within_one_polygon(mesh, res):
+    """Texels whose whole square lies in one UV polygon (row 0 at v = 0, as Blender stores
+    images): there the mean over the footprint (Penumbra) and the value at the centre
+    (Cycles' bake) are means of one face's light, and no island's rim or neighbour mixes in.
+    Polygons are taken as convex (the corners of the square decide)."""
+    uv = np.asarray(mesh["uv"], dtype=np.float64) * res
+    keep = np.zeros((res, res), dtype=bool)
+    k = 0
+    for poly in mesh["polygons"]:
+        q = uv[k:k + len(poly)]
+        k += len(poly)
+        lo = np.maximum(np.floor(q.min(0)).astype(int), 0)
+        hi = np.minimum(np.ceil(q.max(0)).astype(int), res)
+        if np.any(hi - lo < 1):
+            continue
+        cols, rows = np.meshgrid(np.arange(lo[0], hi[0]), np.arange(lo[1], hi[1]))
+        inside = np.ones(cols.shape, dtype=bool)
+        area2 = float(np.sum(q[:, 0] * np.roll(q[:, 1], -1) - np.roll(q[:, 0], -1) * q[:, 1]))
+        sign = 1.0 if area2 > 0 else -1.0
+        for du, dv in ((0, 0), (1, 0), (1, 1), (0, 1)):
+            px, py = cols + du, rows + dv
+            for i in range(len(q)):
+                a, b = q[i], q[(i + 1) % len(q)]
+                cross = (b[0] - a[0]) * (py - a[1]) - (b[1] - a[1]) * (px - a[0])
+                inside &= sign * cross >= 0
+        keep[rows[inside], cols[inside]] = True
     return keep
 
 
@@ -88,7 +104,8 @@ def bench_scene(name, exe, py, work, cfg):
 
     ta, a = cycles(cfg.lightmap_ref_samples, 1, "ref-1")
     tb, b = cycles(cfg.lightmap_ref_samples, 2, "ref-2")
-    keeps = [_interior(x, y) for x, y in zip(a, b)]
+    keeps = [_within_one_polygon(m, res_px) & (x[:, :, 0] >= 0) & (y[:, :, 0] >= 0)
+             for m, x, y in zip(scene["meshes"], a, b)]
     flat = lambda imgs: np.concatenate([x[k] for x, k in zip(imgs, keeps)])  # noqa: E731
     ref, noise = errors.reference(flat(a), flat(b))
 
@@ -124,7 +141,7 @@ def section(results, machine, command):
          f"`{command}` on {m['nproc']} cores ({m['cpu']}, {m['ram_gb']} GB), commit "
          f"{m['commit']}, {m['date']}; load {m['load_at_start']} at the start (the machine is "
          "shared, so times are noisy). Same Lightmap Pack UVs and resolution for both, margin "
-         "0; error is the relative RMS over the texels whose 3×3 neighbourhood is covered, "
+         "0; error is the relative RMS over the texels whose square lies wholly in one UV polygon, "
          "against two Cycles bakes with different seeds whose own noise is taken out. "
          "Penumbra's time is the CLI's whole bake plus every mesh's lightmap; Cycles' is one "
          "bake of every mesh. Cycles' time at Penumbra's error comes from its ladder "
