@@ -155,6 +155,11 @@ def section(results, machine, command):
                  f"{p['rel_rms']:.4f} | {p['cycles_time_at_error']:.1f} "
                  f"({p['cycles_time_how']}) | {p['speedup']:.1f}× | "
                  f"{r['ref_samples']}, {r['ref_noise_rel_rms']:.4f} |")
+    met = [r["scene"] for r in results if r["rows"][0]["speedup"] >= 10]
+    missed = [r["scene"] for r in results if not r["rows"][0]["speedup"] >= 10]
+    L.append(f"\nTarget (at equal error, ≥ 10× faster than Cycles): met on {len(met)} of "
+             f"{len(results)} scenes" + (f" ({', '.join(met)})" if met else "")
+             + (f"; not on {', '.join(missed)}" if missed else "") + ".")
     L.append("\nCycles' ladder (time of the bake call, error):\n")
     L.append("| scene | " + " | ".join(c["method"] for c in results[0]["rows"][1:]) + " |")
     L.append("|---|" + "---:|" * (len(results[0]["rows"]) - 1))

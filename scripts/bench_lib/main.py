@@ -342,6 +342,11 @@ def main():
                     help="only the lightmap rows (Penumbra against Cycles' bake to an image); "
                     "writes OUT/lightmaps.json and their section of OUT/results.md and README.md")
     a = ap.parse_args()
+    if a.report_only and a.lightmap_only:
+        with open(os.path.join(a.out, "lightmaps.json")) as f:
+            lm = json.load(f)
+        write_lightmaps(lm["scenes"], lm["machine"], lm["command"], a.out)
+        return
     if a.report_only:
         with open(os.path.join(a.out, "results.json")) as f:
             res = json.load(f)
