@@ -235,6 +235,15 @@ def test_a_bad_setting_caught_by_the_core(room_scene, empty):
     _refused(empty, ["element_size"])
 
 
+def test_a_bake_over_the_memory_limit_is_refused_before_it_starts(room_scene, empty):
+    s = empty.scene.penumbra
+    s.use_custom_size = True
+    s.element_size = s.penumbra_element_size = 0.01  # millions of elements, under max_elements
+    s.max_memory_gb = 0.25
+    message = _refused(empty, ["element_size", "max_memory", "256.0 MiB"])
+    assert message.count("settings.") == 1, message
+
+
 def test_cancel_leaves_the_scene_untouched(room_scene, empty):
     empty.scene.penumbra.quality = "HIGH"
     before = snapshot()

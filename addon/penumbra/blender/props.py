@@ -67,6 +67,17 @@ class PenumbraSettings(bpy.types.PropertyGroup):
         max=0.5,
         precision=4,
     )
+    max_memory_gb: FloatProperty(
+        name="Memory Limit (GB)",
+        description=(
+            "Refuse a bake that would need more memory than this, before it starts "
+            "(0: half of this machine's memory)"
+        ),
+        default=0.0,
+        min=0.0,
+        soft_max=256.0,
+        precision=1,
+    )
     lighting_only: BoolProperty(
         name="Lighting Only",
         description="Bake irradiance/π without surface colour (a lightmap to multiply by albedo later)",

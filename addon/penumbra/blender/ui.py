@@ -30,6 +30,7 @@ class PENUMBRA_PT_radiosity(bpy.types.Panel):
         row.prop(s, "convergence")
         layout.prop(s, "lighting_only")
         layout.prop(s, "hide_originals")
+        layout.prop(s, "max_memory_gb")
 
         layout.prop(s, "output")
         col = layout.column()

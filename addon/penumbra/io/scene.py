@@ -61,10 +61,15 @@ def settings_dict(settings, meshes, lights):
     else:
         coarse, fine = QUALITY_FRACTIONS[settings.quality]
         element, penumbra = coarse * diag, fine * diag
-    return {
+    out = {
         "element_size": float(element),
         "penumbra_element_size": float(min(penumbra, element)),
         "indirect": bool(settings.use_indirect),
         "convergence": float(settings.convergence),
         "lighting_only": bool(settings.lighting_only),
     }
+    # 0 leaves the core's default (half of the machine's memory).
+    gb = float(getattr(settings, "max_memory_gb", 0.0))
+    if gb > 0.0:
+        out["max_memory"] = int(gb * (1 << 30))
+    return out

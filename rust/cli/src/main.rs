@@ -47,6 +47,10 @@ enum Command {
         /// Where lightmaps go (default: beside the output file).
         #[arg(long, value_name = "DIR")]
         lightmap_dir: Option<PathBuf>,
+        /// Most memory the bake may need by the resource model's estimate, like the
+        /// `max_memory` setting: bytes or 8G, 512M (default: half the machine's memory).
+        #[arg(long, value_name = "SIZE", value_parser = penumbra_cli::args::parse_size)]
+        max_memory: Option<u64>,
     },
     /// Check SCENE and report problems without baking.
     Validate { scene: PathBuf },
@@ -146,6 +150,7 @@ fn run(cli: Cli) -> ExitCode {
             lightmap,
             margin,
             lightmap_dir,
+            max_memory,
         } => {
             let text = match read(&scene) {
                 Ok(t) => t,
@@ -160,6 +165,9 @@ fn run(cli: Cli) -> ExitCode {
             }
             if margin.is_some() {
                 json.settings.lightmap_margin = margin;
+            }
+            if max_memory.is_some() {
+                json.settings.max_memory = max_memory;
             }
             // Bad lightmap settings or UVs fail before the bake, not after it.
             if let Err(e) = check_lightmaps(&json) {

@@ -92,6 +92,10 @@ pub struct SettingsJson {
     pub min_angle: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_elements: Option<u64>,
+    /// Bytes the bake may use, at most by the resource model's estimate (default: half the
+    /// machine's memory).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_memory: Option<u64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub indirect: Option<bool>,
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -5,6 +5,7 @@ pub mod convex;
 pub mod json;
 pub mod precision;
 pub mod reach;
+pub mod resources;
 pub mod settings;
 pub mod solids;
 pub mod strict;

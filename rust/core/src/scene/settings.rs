@@ -23,6 +23,8 @@ pub struct Settings {
     /// Smallest inner angle that refinement aims for (degrees).
     pub min_angle: f64,
     pub max_elements: u64,
+    /// Bytes the bake may use (`scene::resources`).
+    pub max_memory: u64,
     pub indirect: bool,
     pub convergence: f64,
     pub max_shots: u64,
@@ -80,6 +82,15 @@ impl Settings {
         if max_elements == 0 {
             return Err(BakeError::setting("max_elements", "must be at least 1"));
         }
+        let max_memory = s
+            .max_memory
+            .unwrap_or_else(crate::scene::resources::default_max_memory);
+        if max_memory < 1 << 20 {
+            return Err(BakeError::setting(
+                "max_memory",
+                format!("{max_memory} bytes: must be at least 1 MiB (1048576)"),
+            ));
+        }
         let convergence = s.convergence.unwrap_or(1e-3);
         if !(convergence.is_finite() && convergence > 0.0 && convergence < 1.0) {
             return Err(BakeError::setting(
@@ -136,6 +147,7 @@ impl Settings {
             patch_size,
             min_angle,
             max_elements,
+            max_memory,
             indirect: s.indirect.unwrap_or(true),
             convergence,
             max_shots,

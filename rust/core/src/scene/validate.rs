@@ -83,19 +83,10 @@ pub fn validate(s: &SceneJson) -> Result<Scene, BakeError> {
     let diag = (hi - lo).length();
     let settings = Settings::from_json(&s.settings, diag)?;
 
-    // Refuse up front what would not fit: at the coarse size each element covers about
-    // sqrt(3)/4 · size², and penumbra only adds to that.
-    let total_area: f64 = faces.iter().map(|f| f.area).sum();
-    let est = total_area / (0.433 * settings.element_size * settings.element_size);
-    if est > settings.max_elements as f64 {
-        return Err(BakeError::setting(
-            "element_size",
-            format!(
-                "{} would make about {:.0} elements, over max_elements = {} (raise element_size or max_elements)",
-                settings.element_size, est, settings.max_elements
-            ),
-        ));
-    }
+    // Refuse up front what would not fit, before any stage allocates.
+    let lightmaps = s.meshes.iter().filter(|m| m.uv.is_some()).count();
+    let est = super::resources::estimate(&faces, lights.len(), &settings, &s.settings, lightmaps);
+    super::resources::check(&est, &settings)?;
     Ok(Scene {
         meshes,
         faces,
