@@ -137,6 +137,48 @@ fn physical_memory() -> Option<u64> {
 #[cfg(test)]
 mod test {
     use super::*;
+    use crate::SceneJson;
+
+    /// A 10 m × 10 m floor under a 1 m square light, with `settings` (JSON).
+    fn floor(settings: &str) -> SceneJson {
+        SceneJson::from_str(&format!(
+            r#"{{"format":"penumbra-scene","version":1,
+            "meshes":[{{"name":"Floor","positions":[[-5,-5,0],[5,-5,0],[5,5,0],[-5,5,0]],
+                        "polygons":[[0,1,2,3]]}}],
+            "lights":[{{"name":"Area","polygon":[[-0.5,-0.5,2],[-0.5,0.5,2],[0.5,0.5,2],[0.5,-0.5,2]],
+                        "radiance":[1,1,1]}}],
+            "settings":{settings}}}"#
+        ))
+        .unwrap()
+    }
+
+    #[test]
+    fn estimate_is_the_coarse_mesh_and_its_bytes() {
+        let json = floor(r#"{"element_size":0.1}"#);
+        let scene = crate::scene::validate(&json).unwrap();
+        let est = estimate(&scene.faces, 1, &scene.settings, &json.settings, 0);
+        // 100 m² / (0.433 · 0.01 m²) elements, 301 bytes each, half as many vertices.
+        let elements = 100.0 / (0.433 * 0.01);
+        assert!((est.elements - elements).abs() < 1e-6 * elements);
+        assert!((est.bytes - elements * 301.0).abs() < 1e-6 * est.bytes);
+        assert!((est.vertex_light_pairs - elements / 2.0).abs() < 1e-6 * elements);
+    }
+
+    #[test]
+    fn refused_in_validation_naming_the_setting() {
+        let json = floor(
+            r#"{"element_size":0.001,"max_elements":18446744073709551615,"max_memory":1073741824}"#,
+        );
+        let e = crate::scene::validate(&json).unwrap_err().to_string();
+        assert!(
+            e.starts_with("settings.element_size: 0.001 would make about 230946882 elements"),
+            "{e}"
+        );
+        assert!(
+            e.ends_with("over max_memory = 1.00 GiB (raise element_size or max_memory)"),
+            "{e}"
+        );
+    }
 
     #[test]
     fn default_is_half_the_machine() {
