@@ -3,6 +3,7 @@
 
 pub mod convex;
 pub mod json;
+pub mod machine;
 pub mod precision;
 pub mod reach;
 pub mod resources;

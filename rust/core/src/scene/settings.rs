@@ -23,7 +23,7 @@ pub struct Settings {
     /// Smallest inner angle that refinement aims for (degrees).
     pub min_angle: f64,
     pub max_elements: u64,
-    /// Bytes the bake may use (`scene::resources`).
+    /// Bytes the bake may use by the resource model's estimate (`scene::resources`).
     pub max_memory: u64,
     pub indirect: bool,
     pub convergence: f64,
@@ -84,7 +84,7 @@ impl Settings {
         }
         let max_memory = s
             .max_memory
-            .unwrap_or_else(crate::scene::resources::default_max_memory);
+            .unwrap_or_else(crate::scene::machine::default_max_memory);
         if max_memory < 1 << 20 {
             return Err(BakeError::setting(
                 "max_memory",
