@@ -8,6 +8,7 @@ import numpy as np
 
 from ..io.lights import lights_to_scene
 from ..io.materials import polygon_colors
+from ..io.world import world_radiance
 from ..io.scene import LIGHTMAP_UV, MESH_TYPES, SOURCE_KEY, ExportError, loop_order, polygon_area, settings_dict
 
 __all__ = ["LIGHTMAP_UV", "SOURCE_KEY", "ExportError", "Export", "export_scene"]
@@ -50,10 +51,13 @@ def export_scene(context, settings, objects=None):
     for o in lights:
         light_dicts.extend(_light(o, depsgraph))
     emissive = any(np.any(np.asarray(m["emission"]) > 0.0) for m in meshes)
-    if not light_dicts and not emissive:
-        raise ExportError("No lights: add a light or select one (or give a material emission)")
+    world = world_radiance(getattr(context.scene, "world", None), warnings)
+    if not light_dicts and not emissive and world is None:
+        raise ExportError("No lights: add a light or select one (or give a material emission, or the world a colour)")
 
     scene = {"meshes": meshes, "lights": light_dicts, "settings": settings_dict(settings, meshes, light_dicts)}
+    if world is not None:
+        scene["settings"]["world"] = world
     return Export(scene, sources, lights, warnings)
 
 

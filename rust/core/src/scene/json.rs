@@ -114,6 +114,10 @@ pub struct SettingsJson {
     pub visibility_rays: Option<u32>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub threads: Option<u32>,
+    /// Radiance of a uniform world around the scene (Blender's Background colour ×
+    /// strength), W·sr⁻¹·m⁻² per channel; none when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub world: Option<[f64; 3]>,
     /// Texels on a side of each lightmap; lightmaps are made for meshes with `uv` when set.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lightmap_resolution: Option<i64>,

@@ -2,6 +2,7 @@
 //! occluders alike) that remember their source polygon; lights become `Light`s.
 
 pub mod convex;
+pub mod emitters;
 pub mod json;
 pub mod precision;
 pub mod reach;
@@ -93,6 +94,9 @@ pub struct Light {
     /// Index in the input `lights` array (relations are reported in this order).
     pub index: usize,
     pub kind: LightKind,
+    /// For a light made from an emissive face (`emitters`), that face: its emission reaches
+    /// the scene through this light, so the indirect stage does not send it again.
+    pub from_face: Option<u32>,
 }
 
 /// A scene ready for the pipeline.
