@@ -177,6 +177,10 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
         .zip(&scene.faces)
         .map(|(rr, f)| {
             progress.check()?;
+            // A mesh without output needs elements only to reflect light to the others.
+            if !scene.meshes[f.mesh as usize].output && !scene.settings.indirect {
+                return Ok(ReceiverMesh::default());
+            }
             let sizing = Sizing::new(f, &scene.lights, &scene.settings);
             mesh::mesh_receiver(rr, &sizing, &scene.settings, &tol, &budget, progress)
         })
@@ -338,6 +342,9 @@ fn output(scene: &Scene, tol: &Tolerances, el: &Elements, colors: &[[f64; 3]]) -
     let mut remap = vec![u32::MAX; el.positions.len()];
     for (t, tri) in el.triangles.iter().enumerate() {
         let f = &scene.faces[el.tri_face[t] as usize];
+        if !scene.meshes[f.mesh as usize].output {
+            continue;
+        }
         let m = &mut out[f.mesh as usize];
         let c = tri.map(|v| canon[v as usize]);
         // Two corners welded into one (a triangle under the weld distance, 1e-9 of the

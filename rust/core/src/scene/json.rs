@@ -37,6 +37,10 @@ pub struct MeshJson {
     pub albedo: Option<PerPolygon>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub emission: Option<PerPolygon>,
+    /// `false`: the mesh takes part (it casts shadows, reflects and emits light) but gets no
+    /// output; the bake lists it with no triangles. Default `true`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub output: Option<bool>,
     /// Lightmap UVs, one per polygon corner (polygons flattened in order), as Blender's loops.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub uv: Option<Vec<[f64; 2]>>,

@@ -51,6 +51,9 @@ impl Face {
 #[derive(Debug, Clone)]
 pub struct MeshInfo {
     pub name: String,
+    /// Whether the bake writes this mesh's triangles (`MeshJson::output`); a mesh without
+    /// output still casts shadows, reflects and emits.
+    pub output: bool,
     pub n_polygons: usize,
     /// Faces of this mesh are `faces[face_start..face_end]`.
     pub face_start: usize,

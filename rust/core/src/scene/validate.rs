@@ -41,6 +41,7 @@ pub fn validate(s: &SceneJson) -> Result<Scene, BakeError> {
         occluders.extend(find_solids(m, &faces, start));
         meshes.push(MeshInfo {
             name: m.name.clone(),
+            output: m.output.unwrap_or(true),
             n_polygons: m.polygons.len(),
             face_start: start,
             face_end: faces.len(),
