@@ -8,6 +8,7 @@ import numpy as np
 
 from ..io.lights import lights_to_scene
 from ..io.materials import polygon_colors
+from ..io.world import world_radiance
 from ..io.scene import LIGHTMAP_UV, MESH_TYPES, SOURCE_KEY, ExportError, loop_order, polygon_area, settings_dict
 
 __all__ = ["LIGHTMAP_UV", "SOURCE_KEY", "ExportError", "Export", "export_scene"]
@@ -31,9 +32,24 @@ def export_scene(context, settings, objects=None):
     """
     if objects is None:
         objects = list(context.selected_objects)
-    sources = _sources(objects)
+    # Every visible mesh takes part (shadows, bounces, emission); the scope and the Shadow
+    # Only property decide which get outputs. Earlier bakes never take part: they would lie
+    # on top of their sources.
+    visible = [
+        o
+        for o in context.view_layer.objects
+        if o.type in MESH_TYPES and o.visible_get() and not o.hide_render and SOURCE_KEY not in o.keys()
+    ]
+    scope = getattr(settings, "scope", "SELECTED")
+    sources = _sources(visible if scope == "VISIBLE" else objects)
+    shadow_only = [o for o in sources if getattr(o, "penumbra_shadow_only", False)]
+    sources = [o for o in sources if o not in shadow_only]
     if not sources:
+        if shadow_only:
+            raise ExportError('Nothing to bake: "%s" is set to Shadow Only' % shadow_only[0].name)
         raise ExportError("Nothing selected: select the meshes to bake")
+    scenery = [o for o in visible if o not in sources]
+    scenery += [o for o in shadow_only if o not in scenery]
     lights = [o for o in objects if o.type == "LIGHT"]
     if not lights:
         lights = [
@@ -46,14 +62,24 @@ def export_scene(context, settings, objects=None):
     warnings = []
     want_uv = getattr(settings, "output", "MESH") != "MESH"
     meshes = [_mesh(o, depsgraph, warnings, want_uv) for o in sources]
+    # Outputs first: the bake's meshes and ``sources`` are zipped, and the scenery after
+    # them has no output.
+    for o in scenery:
+        m = _mesh(o, depsgraph, warnings, False)
+        m["output"] = False
+        meshes.append(m)
     light_dicts = []
     for o in lights:
         light_dicts.extend(_light(o, depsgraph))
     emissive = any(np.any(np.asarray(m["emission"]) > 0.0) for m in meshes)
-    if not light_dicts and not emissive:
-        raise ExportError("No lights: add a light or select one (or give a material emission)")
+    world = world_radiance(getattr(context.scene, "world", None), warnings)
+    if not light_dicts and not emissive and world is None:
+        raise ExportError("No lights: add a light or select one (or give a material emission, or the world a colour)")
 
-    scene = {"meshes": meshes, "lights": light_dicts, "settings": settings_dict(settings, meshes, light_dicts)}
+    outputs = [m for m in meshes if m.get("output", True)]
+    scene = {"meshes": meshes, "lights": light_dicts, "settings": settings_dict(settings, outputs, light_dicts)}
+    if world is not None:
+        scene["settings"]["world"] = world
     return Export(scene, sources, lights, warnings)
 
 

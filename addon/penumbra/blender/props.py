@@ -21,6 +21,15 @@ def _preview_changed(settings, context):
 
 
 class PenumbraSettings(bpy.types.PropertyGroup):
+    scope: EnumProperty(
+        name="Bake",
+        description="Which meshes get baked outputs; every visible mesh takes part either way",
+        items=(
+            ("SELECTED", "Selected", "Bake the selected meshes; every other visible mesh still casts shadows and reflects light"),
+            ("VISIBLE", "Visible", "Bake every visible mesh"),
+        ),
+        default="SELECTED",
+    )
     quality: EnumProperty(
         name="Quality",
         description="Element size relative to the size of the baked scene",
@@ -134,8 +143,14 @@ class PenumbraSettings(bpy.types.PropertyGroup):
 def register():
     bpy.utils.register_class(PenumbraSettings)
     bpy.types.Scene.penumbra = PointerProperty(type=PenumbraSettings)
+    bpy.types.Object.penumbra_shadow_only = BoolProperty(
+        name="Penumbra: Shadow Only",
+        description="Take part in Penumbra bakes (cast shadows, reflect and emit light) but never get a baked output",
+        default=False,
+    )
 
 
 def unregister():
+    del bpy.types.Object.penumbra_shadow_only
     del bpy.types.Scene.penumbra
     bpy.utils.unregister_class(PenumbraSettings)

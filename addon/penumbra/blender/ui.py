@@ -17,6 +17,10 @@ class PENUMBRA_PT_radiosity(bpy.types.Panel):
         layout.use_property_decorate = False
         s = context.scene.penumbra
 
+        layout.prop(s, "scope")
+        ob = context.active_object
+        if ob is not None and ob.type == "MESH":
+            layout.prop(ob, "penumbra_shadow_only", text="Active: Shadow Only")
         layout.prop(s, "quality")
         layout.prop(s, "use_custom_size")
         sizes = layout.column(align=True)

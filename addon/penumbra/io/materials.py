@@ -29,7 +29,8 @@ surface normal, which is the direction a bake looks from). Measured with bpy 5.0
   gives, and what lights other surfaces: an emissive quad lights a receiver exactly like a
   polygon light of that radiance — tested); albedo 0. Principled: emission = Emission Color ·
   Emission Strength. NOTE: Cycles' mesh emission is two-sided (tested: flipping the quad
-  changes nothing), unlike the one-sided light polygons of the scene JSON.
+  changes nothing); the core makes each emissive face an area light on both sides
+  (`scene/emitters.rs`; tests/test_emitters_cycles.py checks it against Cycles).
 * Mix Shader: (1 − Fac) · A + Fac · B; Add Shader: A + B (both for albedo and emission).
 * Other BSDFs (Glossy, Glass, Refraction, Translucent, Transparent, Toon, Sheen, hair,
   Metallic): no diffuse closure → albedo 0. Subsurface Scattering: albedo = Color.

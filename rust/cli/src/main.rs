@@ -131,8 +131,9 @@ fn run(cli: Cli) -> ExitCode {
                     for w in &s.warnings {
                         eprintln!("penumbra: warning: {w}");
                     }
+                    let emitters = s.lights.iter().filter(|l| l.from_face.is_some()).count();
                     println!(
-                        "ok: {} meshes, {} convex faces, {} lights",
+                        "ok: {} meshes, {} convex faces, {} lights ({emitters} of them from emissive faces)",
                         s.meshes.len(),
                         s.faces.len(),
                         s.lights.len()

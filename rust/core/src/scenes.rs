@@ -29,6 +29,7 @@ pub fn polygons_mesh(name: &str, polys: Vec<Vec<P>>, albedo: Option<[f64; 3]>) -
         albedo: albedo.map(PerPolygon::Uniform),
         emission: None,
         uv: None,
+        output: None,
     }
 }
 

@@ -6,27 +6,6 @@ mod common;
 use common::*;
 use std::f64::consts::PI;
 
-/// Irradiance from a unit-radiance rectangle at height h whose corner is straight above the
-/// point, extending a × b (the classic corner form factor, times π).
-fn corner(a: f64, b: f64, h: f64) -> f64 {
-    let (a, b) = (a / h, b / h);
-    let (sa, sb) = ((1.0 + a * a).sqrt(), (1.0 + b * b).sqrt());
-    0.5 * (a / sa * (b / sa).atan() + b / sb * (a / sb).atan())
-}
-
-fn signed_corner(x: f64, y: f64, h: f64) -> f64 {
-    x.signum() * y.signum() * corner(x.abs(), y.abs(), h)
-}
-
-/// Irradiance at (px, py, 0) from the unit-radiance rectangle [x0,x1]×[y0,y1] at height h.
-fn rect(px: f64, py: f64, [x0, x1, y0, y1]: [f64; 4], h: f64) -> f64 {
-    if x1 <= x0 || y1 <= y0 {
-        return 0.0;
-    }
-    let g = |x: f64, y: f64| signed_corner(x - px, y - py, h);
-    g(x1, y1) - g(x0, y1) - g(x1, y0) + g(x0, y0)
-}
-
 #[test]
 fn penumbra_values_match_rectangle_difference() {
     let radiance = 3.0;

@@ -22,6 +22,7 @@ const MESH_KEYS: &[&str] = &[
     "albedo",
     "emission",
     "uv",
+    "output",
 ];
 
 pub fn from_py(scene: &Bound<'_, PyAny>) -> Result<SceneJson, Error> {
@@ -183,6 +184,16 @@ fn mesh(obj: &Bound<'_, PyAny>, index: usize) -> Result<MeshJson, Error> {
         emission,
         uv: match d.get_item("uv").ok().flatten() {
             Some(a) if !a.is_none() => Some(uv_rows(&a, &object)?),
+            _ => None,
+        },
+        output: match d.get_item("output").ok().flatten() {
+            Some(a) if !a.is_none() => Some(a.extract::<bool>().map_err(|_| {
+                Error::from(penumbra::BakeError::invalid(
+                    &object,
+                    "output",
+                    "must be True or False",
+                ))
+            })?),
             _ => None,
         },
     })

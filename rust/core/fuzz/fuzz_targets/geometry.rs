@@ -40,6 +40,8 @@ fn mesh(name: String, polys: Vec<Vec<[f64; 3]>>) -> MeshJson {
         polygons,
         albedo: None,
         emission: None,
+        uv: None,
+        output: None,
     }
 }
 

@@ -24,6 +24,9 @@ pub const DISTANCE_TOLERANCE: f64 = 1e-6;
 pub fn check(scene: &Scene, out: &[BakedMesh]) -> Result<(), BakeError> {
     let weld = 1e-9 * scene.diagonal();
     for (mi, (info, baked)) in scene.meshes.iter().zip(out).enumerate() {
+        if !info.output {
+            continue;
+        }
         let obj = format!("mesh {:?} (meshes[{mi}])", info.name);
         let faces = &scene.faces[info.face_start..info.face_end];
         // Convex pieces of each source polygon (validate keeps a polygon's pieces together).

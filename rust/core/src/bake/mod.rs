@@ -178,6 +178,10 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
         .zip(&scene.faces)
         .map(|(rr, f)| {
             progress.check()?;
+            // A mesh without output needs elements only to reflect light to the others.
+            if !scene.meshes[f.mesh as usize].output && !scene.settings.indirect {
+                return Ok(ReceiverMesh::default());
+            }
             let sizing = Sizing::new(f, &scene.lights, &scene.settings);
             mesh::mesh_receiver(rr, &sizing, &scene.settings, &tol, &budget, progress)
         })
@@ -194,11 +198,27 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
     [stats.pairs_umbra, stats.pairs_lit, stats.pairs_penumbra] = pairs;
 
     let mut irradiance = direct;
-    if scene.settings.indirect {
+    let occluders = (scene.settings.indirect || scene.settings.world != DVec3::ZERO)
+        .then(|| Occluders::new(&scene.faces));
+    if let (Some(occ), true) = (&occluders, scene.settings.world != DVec3::ZERO) {
+        progress.stage("world light");
+        let t = Instant::now();
+        let w = direct::world::world_irradiance(
+            scene.settings.world,
+            &elements,
+            occ,
+            scene.settings.visibility_rays,
+            progress,
+        )?;
+        stats.T_direct += t.elapsed().as_secs_f64();
+        for (e, x) in irradiance.iter_mut().zip(&w) {
+            *e += *x;
+        }
+    }
+    if let (Some(occluders), true) = (&occluders, scene.settings.indirect) {
         progress.stage("indirect light");
         let t = Instant::now();
-        let occluders = Occluders::new(&scene.faces);
-        let ind = indirect::indirect(scene, &elements, &irradiance, &occluders, progress)?;
+        let ind = indirect::indirect(scene, &elements, &irradiance, occluders, progress)?;
         stats.T_rs = t.elapsed().as_secs_f64();
         stats.N_p = ind.patches;
         stats.shots = ind.shots;
@@ -311,9 +331,17 @@ fn output(scene: &Scene, tol: &Tolerances, el: &Elements, colors: &[[f64; 3]]) -
         })
         .collect();
     let canon = weld(scene, tol, el, colors);
+    let input_lights = scene
+        .lights
+        .iter()
+        .filter(|l| l.from_face.is_none())
+        .count();
     let mut remap = vec![u32::MAX; el.positions.len()];
     for (t, tri) in el.triangles.iter().enumerate() {
         let f = &scene.faces[el.tri_face[t] as usize];
+        if !scene.meshes[f.mesh as usize].output {
+            continue;
+        }
         let m = &mut out[f.mesh as usize];
         let c = tri.map(|v| canon[v as usize]);
         // Two corners welded into one (a triangle under the weld distance, 1e-9 of the
@@ -332,10 +360,13 @@ fn output(scene: &Scene, tol: &Tolerances, el: &Elements, colors: &[[f64; 3]]) -
         }
         m.triangles.push(idx);
         m.source_polygon.push(f.source_polygon);
+        // One code per input light: lights made from emissive faces come after them and
+        // are not in the input's `lights` array.
         m.relation.push(
             el.regions[el.tri_region[t] as usize]
                 .relations
                 .iter()
+                .take(input_lights)
                 .map(|r| r.code())
                 .collect(),
         );

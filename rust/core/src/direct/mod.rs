@@ -5,6 +5,7 @@
 //! penumbra contains one of those triangles as candidates.
 
 pub mod exact;
+pub mod world;
 
 use glam::DVec3;
 use rayon::prelude::*;

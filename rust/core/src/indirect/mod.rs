@@ -129,9 +129,16 @@ fn indirect_at(
         settings.visibility_rays,
     );
     let albedo = |p: &Patch| scene.faces[p.face as usize].albedo;
+    // Emissive faces that are also area lights have sent their light as direct light.
+    let mut emission: Vec<DVec3> = scene.faces.iter().map(|f| f.emission).collect();
+    for l in &scene.lights {
+        if let Some(f) = l.from_face {
+            emission[f as usize] = DVec3::ZERO;
+        }
+    }
     let mut unshot: Vec<DVec3> = patches
         .iter()
-        .map(|p| albedo(p) * mean(&p.weights, direct) + PI * scene.faces[p.face as usize].emission)
+        .map(|p| albedo(p) * mean(&p.weights, direct) + PI * emission[p.face as usize])
         .collect();
     let power = |b: DVec3, p: &Patch| b.element_sum() * p.area;
     let emitted: f64 = unshot.iter().zip(&patches).map(|(b, p)| power(*b, p)).sum();

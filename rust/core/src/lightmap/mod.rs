@@ -186,7 +186,7 @@ pub fn scene_lightmaps(
     };
     let mut out = Vec::with_capacity(json.meshes.len());
     for (mi, (m, b)) in json.meshes.iter().zip(&bake.meshes).enumerate() {
-        let Some(uvs) = &m.uv else {
+        let Some(uvs) = m.uv.as_ref().filter(|_| m.output != Some(false)) else {
             out.push(None);
             continue;
         };

@@ -156,6 +156,7 @@ mod test {
                 verts: lv,
                 radiance: DVec3::ONE,
             },
+            from_face: None,
         };
         let settings = Settings::from_json(
             &SettingsJson {

@@ -37,6 +37,10 @@ pub struct MeshJson {
     pub albedo: Option<PerPolygon>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub emission: Option<PerPolygon>,
+    /// `false`: the mesh takes part (it casts shadows, reflects and emits light) but gets no
+    /// output; the bake lists it with no triangles. Default `true`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub output: Option<bool>,
     /// Lightmap UVs, one per polygon corner (polygons flattened in order), as Blender's loops.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub uv: Option<Vec<[f64; 2]>>,
@@ -118,6 +122,10 @@ pub struct SettingsJson {
     pub visibility_rays: Option<u32>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub threads: Option<u32>,
+    /// Radiance of a uniform world around the scene (Blender's Background colour ×
+    /// strength), W·sr⁻¹·m⁻² per channel; none when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub world: Option<[f64; 3]>,
     /// Texels on a side of each lightmap; lightmaps are made for meshes with `uv` when set.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lightmap_resolution: Option<i64>,

@@ -2,6 +2,7 @@
 //! occluders alike) that remember their source polygon; lights become `Light`s.
 
 pub mod convex;
+pub mod emitters;
 pub mod json;
 pub mod machine;
 pub mod precision;
@@ -52,6 +53,9 @@ impl Face {
 #[derive(Debug, Clone)]
 pub struct MeshInfo {
     pub name: String,
+    /// Whether the bake writes this mesh's triangles (`MeshJson::output`); a mesh without
+    /// output still casts shadows, reflects and emits.
+    pub output: bool,
     pub n_polygons: usize,
     /// Faces of this mesh are `faces[face_start..face_end]`.
     pub face_start: usize,
@@ -95,6 +99,9 @@ pub struct Light {
     /// Index in the input `lights` array (relations are reported in this order).
     pub index: usize,
     pub kind: LightKind,
+    /// For a light made from an emissive face (`emitters`), that face: its emission reaches
+    /// the scene through this light, so the indirect stage does not send it again.
+    pub from_face: Option<u32>,
 }
 
 /// A scene ready for the pipeline.

@@ -36,6 +36,8 @@ pub struct Settings {
     pub penumbra_samples: u32,
     pub visibility_rays: u32,
     pub threads: Option<u32>,
+    /// Radiance of a uniform world (light from every direction not blocked by the scene).
+    pub world: glam::DVec3,
 }
 
 pub const DEFAULT_MAX_ELEMENTS: u64 = 4_000_000;
@@ -141,6 +143,18 @@ impl Settings {
                 ));
             }
         }
+        let world = match s.world {
+            None => glam::DVec3::ZERO,
+            Some(c) if c.iter().all(|x| x.is_finite() && (0.0..=1e30).contains(x)) => {
+                glam::DVec3::from_array(c)
+            }
+            Some(c) => {
+                return Err(BakeError::setting(
+                    "world",
+                    format!("{c:?} must be three finite radiances ≥ 0"),
+                ))
+            }
+        };
         Ok(Settings {
             element_size,
             penumbra_element_size,
@@ -158,6 +172,7 @@ impl Settings {
             penumbra_samples,
             visibility_rays,
             threads: s.threads,
+            world,
         })
     }
 }

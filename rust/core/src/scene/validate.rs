@@ -28,9 +28,10 @@ pub fn validate(s: &SceneJson) -> Result<Scene, BakeError> {
     if s.meshes.is_empty() {
         return Err(BakeError::Empty("the scene has no meshes".into()));
     }
-    if s.lights.is_empty() && !has_emission(s) {
+    let world = s.settings.world.is_some_and(|w| w.iter().any(|x| *x > 0.0));
+    if s.lights.is_empty() && !has_emission(s) && !world {
         return Err(BakeError::Empty(
-            "the scene has no lights and no emissive polygons".into(),
+            "the scene has no lights, no emissive polygons and no world light".into(),
         ));
     }
     for (mi, m) in s.meshes.iter().enumerate() {
@@ -40,6 +41,7 @@ pub fn validate(s: &SceneJson) -> Result<Scene, BakeError> {
         occluders.extend(find_solids(m, &faces, start));
         meshes.push(MeshInfo {
             name: m.name.clone(),
+            output: m.output.unwrap_or(true),
             n_polygons: m.polygons.len(),
             face_start: start,
             face_end: faces.len(),
@@ -79,6 +81,15 @@ pub fn validate(s: &SceneJson) -> Result<Scene, BakeError> {
         lights.push(light);
     }
     warnings.extend(super::reach::light_warnings(&lights, &faces));
+    let emitters = super::emitters::emitter_lights(
+        &meshes,
+        &faces,
+        &face_occluder,
+        &occluders,
+        lights.len(),
+        &mut warnings,
+    );
+    lights.extend(emitters);
     super::precision::check(&meshes, &faces, lo, hi)?;
     let diag = (hi - lo).length();
     let settings = Settings::from_json(&s.settings, diag)?;
@@ -407,6 +418,7 @@ fn validate_light(li: usize, l: &LightJson, obj: &str) -> Result<Light, BakeErro
         name: l.name.clone(),
         index: li,
         kind,
+        from_face: None,
     })
 }
 

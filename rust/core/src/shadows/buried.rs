@@ -149,6 +149,7 @@ mod test {
             albedo: None,
             emission: None,
             uv: None,
+            output: None,
         }
     }
 

@@ -1,0 +1,125 @@
+"""An emissive panel as the only light, baked by the add-on and by Cycles (issue 14).
+
+A floor grid under a small block, lit by nothing but a quad with an Emission material a
+little above them. Cycles treats the quad as a light (both sides emit); Penumbra turns the
+emissive face into two area lights (front and back), so the block's shadow on the floor has
+a penumbra meshed like an area light's and the floor is lit with indirect light turned off,
+where it was black before. Compared at the floor grid's interior vertices (which are vertices
+of Penumbra's output too), Cycles' noise from two seeds taken out, with indirect light off
+(Cycles: Diffuse bake of the direct pass) and on (direct + indirect).
+"""
+
+import bpy
+import numpy as np
+import pytest
+
+import cycles_ref as cr
+from penumbra.blender.import_ import ATTRIBUTE
+
+SAMPLES = 1024
+GRID = 13
+SIDE = 3.0
+TOL = 0.03
+
+
+def _floor():
+    t = np.linspace(-SIDE / 2, SIDE / 2, GRID)
+    xs, ys = np.meshgrid(t, t, indexing="xy")
+    verts = np.stack([xs.ravel(), ys.ravel(), np.zeros(GRID * GRID)], axis=1)
+    faces = [(j * GRID + i, j * GRID + i + 1, (j + 1) * GRID + i + 1, (j + 1) * GRID + i)
+             for j in range(GRID - 1) for i in range(GRID - 1)]
+    me = bpy.data.meshes.new("Floor")
+    me.from_pydata(verts.tolist(), [], faces)
+    me.update()
+    me.materials.append(cr.diffuse_material("FloorMat", (0.6, 0.6, 0.6)))
+    ob = bpy.data.objects.new("Floor", me)
+    bpy.context.scene.collection.objects.link(ob)
+    return ob
+
+
+def _block():
+    (x0, y0, z0), (x1, y1, z1) = (-0.37, -0.29, 0.0), (0.21, 0.33, 0.45)
+    verts = [(x0, y0, z0), (x1, y0, z0), (x1, y1, z0), (x0, y1, z0),
+             (x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)]
+    faces = [(0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)]
+    me = bpy.data.meshes.new("Block")
+    me.from_pydata(verts, [], faces)
+    me.update()
+    me.materials.append(cr.diffuse_material("BlockMat", (0.5, 0.5, 0.5)))
+    ob = bpy.data.objects.new("Block", me)
+    bpy.context.scene.collection.objects.link(ob)
+    return ob
+
+
+def _panel():
+    """A 0.6 × 0.4 quad at height 1.2, tilted a little, with an Emission material."""
+    import math
+
+    me = bpy.data.meshes.new("Panel")
+    me.from_pydata([(-0.3, -0.2, 0.0), (0.3, -0.2, 0.0), (0.3, 0.2, 0.0), (-0.3, 0.2, 0.0)],
+                   [], [(0, 1, 2, 3)])
+    me.update()
+    # Albedo 0 plus an Emission of radiance (1, 0.9, 0.8) · 12.
+    mat = cr.cycles_setup.lambert_material("Glow", (0.0, 0.0, 0.0), (12.0, 10.8, 9.6))
+    me.materials.append(mat)
+    ob = bpy.data.objects.new("Panel", me)
+    ob.location = (0.35, 0.1, 1.2)
+    ob.rotation_euler = (math.radians(12.0), 0.0, 0.0)
+    bpy.context.scene.collection.objects.link(ob)
+    return ob
+
+
+def _build(seed):
+    scene = cr.new_scene(samples=SAMPLES, seed=seed)
+    cy = scene.cycles
+    cy.max_bounces = cy.diffuse_bounces = 64
+    cy.glossy_bounces = cy.transmission_bounces = cy.volume_bounces = cy.transparent_max_bounces = 0
+    objs = (_floor(), _block(), _panel())
+    bpy.context.view_layer.update()
+    return objs
+
+
+def _ours_at(pos):
+    ob = bpy.data.objects["Floor_baked"]
+    me = ob.data
+    n = len(me.vertices)
+    co = np.empty(n * 3)
+    me.vertices.foreach_get("co", co)
+    mw = np.array(ob.matrix_world)
+    co = co.reshape(-1, 3) @ mw[:3, :3].T + mw[:3, 3]
+    col = np.empty(n * 4, dtype=np.float32)
+    me.color_attributes[ATTRIBUTE].data.foreach_get("color", col)
+    col = col.reshape(-1, 4)[:, :3].astype(np.float64)
+    d = np.linalg.norm(pos[:, None, :] - co[None, :, :], axis=2)
+    nearest = d.argmin(axis=1)
+    assert np.all(d[np.arange(len(pos)), nearest] < 1e-5), "a grid vertex is not in the bake"
+    return col[nearest]
+
+
+@pytest.mark.parametrize("indirect", [False, True])
+def test_emissive_panel_lights_the_floor_like_cycles(indirect):
+    refs = []
+    passes = {"DIRECT", "INDIRECT", "COLOR"} if indirect else {"DIRECT", "COLOR"}
+    for seed in (1, 2):
+        floor, _, _ = _build(seed)
+        refs.append(cr.bake_vertex_colors(floor, pass_filter=passes))
+    (pos, a), (_, b) = refs
+    for o in bpy.context.scene.objects:
+        o.select_set(True)
+    bpy.context.scene.penumbra.use_indirect = indirect
+    assert bpy.ops.penumbra.bake() == {"FINISHED"}
+
+    # Off the floor's border and clear of the block's footprint and contact outline.
+    m = 1e-6
+    inner = (np.abs(pos[:, 0]) < SIDE / 2 - m) & (np.abs(pos[:, 1]) < SIDE / 2 - m)
+    near_block = (pos[:, 0] > -0.40) & (pos[:, 0] < 0.24) & (pos[:, 1] > -0.32) & (pos[:, 1] < 0.36)
+    keep = inner & ~near_block
+    ref = 0.5 * (a[keep] + b[keep])
+    ours = _ours_at(pos[keep])
+    e = ours - ref
+    noise = np.sum((a[keep] - b[keep]) ** 2) / 4.0
+    rms = np.sqrt(max(float(np.sum(e * e)) - noise, 0.0) / e.size) / ref.mean()
+    print(f"\n[emitters] indirect={indirect} ours {ours.mean():.4f} Cycles {ref.mean():.4f} "
+          f"rel RMS {rms:.4f} noise {np.sqrt(noise / e.size) / ref.mean():.4f}")
+    assert ref.mean() > 0.01, "the panel must light the floor in Cycles"
+    assert rms <= TOL

@@ -1,0 +1,63 @@
+"""A grey world over a floor with a block, no lamps, baked by the add-on and by Cycles
+(issue 14). Cycles lights a bake with the world; the add-on exports the world's Background
+colour × strength as ``settings.world`` and the core adds the world light at every vertex
+(ambient occlusion times the world's radiance), then bounces it. Compared at the floor
+grid's interior vertices, with indirect light off (direct pass) and on, Cycles' noise from
+two seeds taken out.
+"""
+
+import bpy
+import numpy as np
+import pytest
+
+import cycles_ref as cr
+from test_emitters_cycles import GRID, SIDE, _block, _floor, _ours_at
+
+SAMPLES = 1024
+TOL = 0.03
+
+
+def _build(seed):
+    scene = cr.new_scene(samples=SAMPLES, seed=seed)
+    cy = scene.cycles
+    cy.max_bounces = cy.diffuse_bounces = 64
+    cy.glossy_bounces = cy.transmission_bounces = cy.volume_bounces = cy.transparent_max_bounces = 0
+    world = bpy.data.worlds.new("Grey")
+    if bpy.app.version < (5, 0, 0):
+        world.use_nodes = True
+    bg = next(n for n in world.node_tree.nodes if n.bl_idname == "ShaderNodeBackground")
+    bg.inputs["Color"].default_value = (0.5, 0.45, 0.4, 1.0)
+    bg.inputs["Strength"].default_value = 2.0
+    scene.world = world
+    floor, block = _floor(), _block()
+    bpy.context.view_layer.update()
+    return floor, block
+
+
+@pytest.mark.parametrize("indirect", [False, True])
+def test_grey_world_lights_the_floor_like_cycles(indirect):
+    refs = []
+    passes = {"DIRECT", "INDIRECT", "COLOR"} if indirect else {"DIRECT", "COLOR"}
+    for seed in (1, 2):
+        floor, _ = _build(seed)
+        refs.append(cr.bake_vertex_colors(floor, pass_filter=passes))
+    (pos, a), (_, b) = refs
+    for o in bpy.context.scene.objects:
+        o.select_set(True)
+    bpy.context.scene.penumbra.use_indirect = indirect
+    assert bpy.ops.penumbra.bake() == {"FINISHED"}
+
+    m = 1e-6
+    inner = (np.abs(pos[:, 0]) < SIDE / 2 - m) & (np.abs(pos[:, 1]) < SIDE / 2 - m)
+    under = (pos[:, 0] > -0.38) & (pos[:, 0] < 0.22) & (pos[:, 1] > -0.30) & (pos[:, 1] < 0.34)
+    keep = inner & ~under
+    ref = 0.5 * (a[keep] + b[keep])
+    ours = _ours_at(pos[keep])
+    e = ours - ref
+    noise = np.sum((a[keep] - b[keep]) ** 2) / 4.0
+    rms = np.sqrt(max(float(np.sum(e * e)) - noise, 0.0) / e.size) / ref.mean()
+    print(f"\n[world] indirect={indirect} ours {ours.mean():.4f} Cycles {ref.mean():.4f} "
+          f"rel RMS {rms:.4f} noise {np.sqrt(noise / e.size) / ref.mean():.4f}")
+    # An open floor under this world is albedo 0.6 × (0.5, 0.45, 0.4) × 2 where nothing hides it.
+    assert ref.max() <= 0.6 * 1.0 * 1.02
+    assert rms <= TOL
