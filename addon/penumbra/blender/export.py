@@ -6,7 +6,7 @@ modifiers, in world space, and the lights in scene-JSON form. Only numpy and
 import bpy
 import numpy as np
 
-from ..io.lights import lights_to_scene
+from ..io.lights import UnsupportedLightError, lights_to_scene
 from ..io.materials import polygon_colors
 from ..io.world import world_radiance
 from ..io.scene import LIGHTMAP_UV, MESH_TYPES, SOURCE_KEY, ExportError, loop_order, polygon_area, settings_dict
@@ -70,10 +70,13 @@ def export_scene(context, settings, objects=None):
         meshes.append(m)
     light_dicts = []
     for o in lights:
-        light_dicts.extend(_light(o, depsgraph))
+        light_dicts.extend(_light(o, depsgraph, warnings))
     emissive = any(np.any(np.asarray(m["emission"]) > 0.0) for m in meshes)
     world = world_radiance(getattr(context.scene, "world", None), warnings)
     if not light_dicts and not emissive and world is None:
+        skipped = [w for w in warnings if w.endswith("left out of this bake")]
+        if skipped:
+            raise ExportError("No usable lights: %s" % skipped[0])
         raise ExportError("No lights: add a light or select one (or give a material emission, or the world a colour)")
 
     outputs = [m for m in meshes if m.get("output", True)]
@@ -157,7 +160,7 @@ def _lightmap_uv(obj, mesh, order):
     return uv.reshape(-1, 2).astype(np.float64)[order]
 
 
-def _light(obj, depsgraph):
+def _light(obj, depsgraph, warnings):
     light = obj.data
     if light.type == "AREA":
         sizes = [("size", light.size)]
@@ -171,7 +174,12 @@ def _light(obj, depsgraph):
             raise ExportError('Light "%s": scale: the area light is scaled to zero size' % obj.name)
     try:
         dicts = lights_to_scene(obj, depsgraph)
-    except ValueError as e:  # a light feature the scene JSON cannot hold; names light and field
+    except UnsupportedLightError as e:
+        # A feature the bake cannot model (spread, shadowless, light linking, a textured
+        # light): the light is left out with one warning, and the rest of the bake goes on.
+        warnings.append("%s; the light is left out of this bake" % e)
+        return []
+    except ValueError as e:  # bad light data; names light and field
         raise ExportError(str(e))
     for d in dicts:
         polygon = d.get("polygon")
