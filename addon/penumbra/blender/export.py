@@ -68,6 +68,7 @@ def export_scene(context, settings, objects=None):
         m = _mesh(o, depsgraph, warnings, False)
         m["output"] = False
         meshes.append(m)
+    meshes.extend(_instances(depsgraph, warnings))
     light_dicts = []
     for o in lights:
         light_dicts.extend(_light(o, depsgraph, warnings))
@@ -84,6 +85,33 @@ def export_scene(context, settings, objects=None):
     if world is not None:
         scene["settings"]["world"] = world
     return Export(scene, sources, lights, warnings)
+
+
+# Instances past this many are left out (one warning): each is a mesh of its own in the bake.
+MAX_INSTANCES = 10000
+
+
+def _instances(depsgraph, warnings):
+    """Meshes that exist only as instances (collection instances, Geometry Nodes instances,
+    particles), realised in world space as scenery: they cast shadows and reflect light but
+    get no output. An instance's object is valid only while the iteration is on it, so each
+    mesh is read at once."""
+    out = []
+    for inst in depsgraph.object_instances:
+        if not inst.is_instance or inst.object is None or inst.object.type not in MESH_TYPES:
+            continue
+        if not inst.show_self:
+            continue
+        if len(out) >= MAX_INSTANCES:
+            warnings.append("more than %d instances: the rest are left out of this bake" % MAX_INSTANCES)
+            break
+        ob = inst.object
+        parent = inst.parent.name if inst.parent is not None else "?"
+        m = _mesh(ob, depsgraph, warnings, False, matrix=inst.matrix_world.copy(),
+                  name="%s (instance %d in %s)" % (ob.name, len(out), parent))
+        m["output"] = False
+        out.append(m)
+    return out
 
 
 def _sources(objects):
@@ -103,15 +131,17 @@ def _sources(objects):
     return out
 
 
-def _mesh(obj, depsgraph, warnings, want_uv=False):
-    obj_eval = obj.evaluated_get(depsgraph)
+def _mesh(obj, depsgraph, warnings, want_uv=False, matrix=None, name=None):
+    """The mesh dict of ``obj`` as evaluated (modifiers applied), in world space; for an
+    instance, ``obj`` is the instance's evaluated object, placed by ``matrix``."""
+    obj_eval = obj if matrix is not None else obj.evaluated_get(depsgraph)
     mesh = obj_eval.to_mesh()
     try:
         n_vert = len(mesh.vertices)
         co = np.empty(n_vert * 3, dtype=np.float32)
         mesh.vertices.foreach_get("co", co)
         local = co.reshape(-1, 3).astype(np.float64)
-        m = np.array(obj_eval.matrix_world, dtype=np.float64)
+        m = np.array(obj_eval.matrix_world if matrix is None else matrix, dtype=np.float64)
         positions = local @ m[:3, :3].T + m[:3, 3]
         bad = ~np.isfinite(positions).all(axis=1)
         if bad.any():
@@ -133,7 +163,7 @@ def _mesh(obj, depsgraph, warnings, want_uv=False):
 
         albedo, emission = polygon_colors(obj_eval, mesh, warnings)
         out = {
-            "name": obj.name,
+            "name": name or obj.name,
             "positions": positions,
             "polygon_vertices": polygon_vertices,
             "polygon_counts": counts,
