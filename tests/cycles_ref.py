@@ -193,7 +193,8 @@ def irradiance_point(points, normal, light):
     r2 = np.sum(d * d, axis=1)
     r = np.sqrt(r2)
     cos_r = np.maximum(d @ n / r, 0.0)
-    f = cos_r / r2
+    # With a radius: Blender's soft falloff, a disk facing the receiver.
+    f = cos_r / (r2 + float(light.get("radius", 0.0)) ** 2)
     spot = light.get("spot")
     if spot is not None:
         sd = np.asarray(spot["direction"], dtype=np.float64)

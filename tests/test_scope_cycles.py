@@ -97,3 +97,41 @@ def test_only_shadow_only_objects_selected_is_a_clear_error():
     with pytest.raises(RuntimeError, match="Shadow Only"):
         bpy.ops.penumbra.bake()
     assert len(bpy.data.objects) == n
+
+
+def test_a_collection_instance_shades_like_the_object_itself():
+    """Instances were skipped without a word; now they take part as scenery."""
+
+    def floor_colours():
+        col = bpy.data.objects["Floor_baked"].data.color_attributes[0].data
+        c = np.empty(len(col) * 4, dtype=np.float32)
+        col.foreach_get("color", c)
+        return c.reshape(-1, 4)[:, :3]
+
+    def bake_floor():
+        for o in bpy.context.scene.objects:
+            o.select_set(o.name == "Floor")
+        assert bpy.ops.penumbra.bake() == {"FINISHED"}
+        c = floor_colours()
+        bpy.data.objects.remove(bpy.data.objects["Floor_baked"])
+        return c
+
+    _build(1)
+    bpy.data.objects.remove(bpy.data.objects["Wall"])
+    settings = bpy.context.scene.penumbra
+    settings.scope, settings.use_indirect = "SELECTED", True
+    direct = bake_floor()
+    # The block moved into a collection outside the scene, shown by an instancing empty at
+    # the same place.
+    block = bpy.data.objects["Block"]
+    coll = bpy.data.collections.new("Props")
+    bpy.context.scene.collection.objects.unlink(block)
+    coll.objects.link(block)
+    empty = bpy.data.objects.new("PropsInstance", None)
+    empty.instance_type = "COLLECTION"
+    empty.instance_collection = coll
+    bpy.context.scene.collection.objects.link(empty)
+    bpy.context.view_layer.update()
+    instanced = bake_floor()
+    assert instanced.shape == direct.shape
+    assert np.allclose(instanced, direct, rtol=1e-5, atol=1e-7)

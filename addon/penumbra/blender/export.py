@@ -6,7 +6,7 @@ modifiers, in world space, and the lights in scene-JSON form. Only numpy and
 import bpy
 import numpy as np
 
-from ..io.lights import lights_to_scene
+from ..io.lights import UnsupportedLightError, lights_to_scene
 from ..io.materials import polygon_colors
 from ..io.world import world_radiance
 from ..io.scene import LIGHTMAP_UV, MESH_TYPES, SOURCE_KEY, ExportError, loop_order, polygon_area, settings_dict
@@ -68,12 +68,16 @@ def export_scene(context, settings, objects=None):
         m = _mesh(o, depsgraph, warnings, False)
         m["output"] = False
         meshes.append(m)
+    meshes.extend(_instances(depsgraph, warnings))
     light_dicts = []
     for o in lights:
-        light_dicts.extend(_light(o, depsgraph))
+        light_dicts.extend(_light(o, depsgraph, warnings))
     emissive = any(np.any(np.asarray(m["emission"]) > 0.0) for m in meshes)
     world = world_radiance(getattr(context.scene, "world", None), warnings)
     if not light_dicts and not emissive and world is None:
+        skipped = [w for w in warnings if w.endswith("left out of this bake")]
+        if skipped:
+            raise ExportError("No usable lights: %s" % skipped[0])
         raise ExportError("No lights: add a light or select one (or give a material emission, or the world a colour)")
 
     outputs = [m for m in meshes if m.get("output", True)]
@@ -81,6 +85,33 @@ def export_scene(context, settings, objects=None):
     if world is not None:
         scene["settings"]["world"] = world
     return Export(scene, sources, lights, warnings)
+
+
+# Instances past this many are left out (one warning): each is a mesh of its own in the bake.
+MAX_INSTANCES = 10000
+
+
+def _instances(depsgraph, warnings):
+    """Meshes that exist only as instances (collection instances, Geometry Nodes instances,
+    particles), realised in world space as scenery: they cast shadows and reflect light but
+    get no output. An instance's object is valid only while the iteration is on it, so each
+    mesh is read at once."""
+    out = []
+    for inst in depsgraph.object_instances:
+        if not inst.is_instance or inst.object is None or inst.object.type not in MESH_TYPES:
+            continue
+        if not inst.show_self:
+            continue
+        if len(out) >= MAX_INSTANCES:
+            warnings.append("more than %d instances: the rest are left out of this bake" % MAX_INSTANCES)
+            break
+        ob = inst.object
+        parent = inst.parent.name if inst.parent is not None else "?"
+        m = _mesh(ob, depsgraph, warnings, False, matrix=inst.matrix_world.copy(),
+                  name="%s (instance %d in %s)" % (ob.name, len(out), parent))
+        m["output"] = False
+        out.append(m)
+    return out
 
 
 def _sources(objects):
@@ -100,15 +131,17 @@ def _sources(objects):
     return out
 
 
-def _mesh(obj, depsgraph, warnings, want_uv=False):
-    obj_eval = obj.evaluated_get(depsgraph)
+def _mesh(obj, depsgraph, warnings, want_uv=False, matrix=None, name=None):
+    """The mesh dict of ``obj`` as evaluated (modifiers applied), in world space; for an
+    instance, ``obj`` is the instance's evaluated object, placed by ``matrix``."""
+    obj_eval = obj if matrix is not None else obj.evaluated_get(depsgraph)
     mesh = obj_eval.to_mesh()
     try:
         n_vert = len(mesh.vertices)
         co = np.empty(n_vert * 3, dtype=np.float32)
         mesh.vertices.foreach_get("co", co)
         local = co.reshape(-1, 3).astype(np.float64)
-        m = np.array(obj_eval.matrix_world, dtype=np.float64)
+        m = np.array(obj_eval.matrix_world if matrix is None else matrix, dtype=np.float64)
         positions = local @ m[:3, :3].T + m[:3, 3]
         bad = ~np.isfinite(positions).all(axis=1)
         if bad.any():
@@ -130,7 +163,7 @@ def _mesh(obj, depsgraph, warnings, want_uv=False):
 
         albedo, emission = polygon_colors(obj_eval, mesh, warnings)
         out = {
-            "name": obj.name,
+            "name": name or obj.name,
             "positions": positions,
             "polygon_vertices": polygon_vertices,
             "polygon_counts": counts,
@@ -157,7 +190,7 @@ def _lightmap_uv(obj, mesh, order):
     return uv.reshape(-1, 2).astype(np.float64)[order]
 
 
-def _light(obj, depsgraph):
+def _light(obj, depsgraph, warnings):
     light = obj.data
     if light.type == "AREA":
         sizes = [("size", light.size)]
@@ -171,7 +204,12 @@ def _light(obj, depsgraph):
             raise ExportError('Light "%s": scale: the area light is scaled to zero size' % obj.name)
     try:
         dicts = lights_to_scene(obj, depsgraph)
-    except ValueError as e:  # a light feature the scene JSON cannot hold; names light and field
+    except UnsupportedLightError as e:
+        # A feature the bake cannot model (spread, shadowless, light linking, a textured
+        # light): the light is left out with one warning, and the rest of the bake goes on.
+        warnings.append("%s; the light is left out of this bake" % e)
+        return []
+    except ValueError as e:  # bad light data; names light and field
         raise ExportError(str(e))
     for d in dicts:
         polygon = d.get("polygon")

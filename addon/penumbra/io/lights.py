@@ -44,10 +44,9 @@ Approximations (documented, not errors)
       intensity. With ``use_soft_falloff`` off Cycles uses a sphere light, whose irradiance on an
       unoccluded receiver that sees the whole sphere is exactly I·cos/d² (tested); with soft
       falloff (the default) Cycles uses a disk of radius r facing the receiver
-      (kernel/light/point.h), which gives exactly I·cos/(d² + r²) (tested), so our point is
-      too bright by r²/d² (0.25 % for r = 0.1 at 2 m; 1.5 % for r = 0.3). A scene-JSON
-      ``radius`` for point lights would make this exact. Shadows are hard (a point) either
-      way. Spots with a radius are approximated the same way (untested).
+      (kernel/light/point.h), which gives exactly I·cos/(d² + r²) (tested): exported with
+      the scene JSON's ``radius``, which the core applies the same way. Shadows are hard (a
+      point) either way. Spots with a radius are exported the same way (untested).
     * SUN ``angle``: exported as an exact direction. Unoccluded receivers get exactly E⊥·cos
       while the sun disk is entirely above their horizon; shadows are hard.
     * ``diffuse_factor`` (and the other influence factors) are EEVEE-only: Cycles ignores them
@@ -198,6 +197,9 @@ def lights_to_scene(obj, depsgraph=None, *, disk_segments: int = DEFAULT_DISK_SE
         else:
             I = S * r * r if r > 0.0 else S / math.pi
         d = {"name": name, "point": co.tolist(), "intensity": I.tolist()}
+        if r > 0.0 and getattr(light, "use_soft_falloff", True):
+            # Cycles' soft falloff: a disk of radius r facing the receiver, I·cos/(d² + r²).
+            d["radius"] = r
         if light.type == "SPOT":
             lens = np.array([np.linalg.norm(X), np.linalg.norm(Y), lz])
             if np.ptp(lens) > _SCALE_TOL * lens.max():
