@@ -250,3 +250,47 @@ def ratio(ours, ref, mask=None):
     if mask is not None:
         ours, ref = ours[mask], ref[mask]
     return float(ours.sum() / ref.sum())
+
+
+def new_bounce_scene(samples: int, seed: int):
+    """``new_scene`` with 64 diffuse bounces and no other kind: what a whole-scene comparison
+    with indirect light needs."""
+    scene = new_scene(samples=samples, seed=seed)
+    cy = scene.cycles
+    cy.max_bounces = cy.diffuse_bounces = 64
+    cy.glossy_bounces = cy.transmission_bounces = cy.volume_bounces = cy.transparent_max_bounces = 0
+    return scene
+
+
+def baked_colors_at(name: str, pos):
+    """Penumbra's colours of the baked object ``<name>_baked`` at the world points ``pos``
+    (each must be one of its vertices: its triangles conform to every input polygon)."""
+    import bpy
+
+    from penumbra.blender.import_ import ATTRIBUTE
+
+    ob = bpy.data.objects[name + "_baked"]
+    me = ob.data
+    n = len(me.vertices)
+    co = np.empty(n * 3)
+    me.vertices.foreach_get("co", co)
+    mw = np.array(ob.matrix_world)
+    co = co.reshape(-1, 3) @ mw[:3, :3].T + mw[:3, 3]
+    col = np.empty(n * 4, dtype=np.float32)
+    me.color_attributes[ATTRIBUTE].data.foreach_get("color", col)
+    col = col.reshape(-1, 4)[:, :3].astype(np.float64)
+    d = np.linalg.norm(pos[:, None, :] - co[None, :, :], axis=2)
+    nearest = d.argmin(axis=1)
+    assert np.all(d[np.arange(len(pos)), nearest] < 1e-5), f"{name}: a grid vertex is not in the bake"
+    return col[nearest]
+
+
+def noise_free_rel_rms(ours, a, b):
+    """Relative RMS of ``ours`` against the mean of two Cycles bakes ``a`` and ``b`` (other
+    seeds), with the variance of that mean, (a − b)²/4, taken out of the squared error; and
+    the reference's own noise on the same scale."""
+    ref = 0.5 * (a + b)
+    e = ours - ref
+    noise = float(np.sum((a - b) ** 2)) / 4.0
+    rms = np.sqrt(max(float(np.sum(e * e)) - noise, 0.0) / e.size) / ref.mean()
+    return rms, np.sqrt(noise / e.size) / ref.mean()

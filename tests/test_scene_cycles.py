@@ -15,7 +15,6 @@ import numpy as np
 import pytest
 
 import cycles_ref as cr
-from penumbra.blender.import_ import ATTRIBUTE
 
 SAMPLES = 1024
 GRID = 7  # vertices per side of each wall
@@ -54,10 +53,7 @@ def _block(lo, hi, color):
 
 
 def _build(seed):
-    scene = cr.new_scene(samples=SAMPLES, seed=seed)
-    cy = scene.cycles
-    cy.max_bounces = cy.diffuse_bounces = 64
-    cy.glossy_bounces = cy.transmission_bounces = cy.volume_bounces = cy.transparent_max_bounces = 0
+    cr.new_bounce_scene(SAMPLES, seed)
     a = SIDE / 2
     white, red, green = (0.7, 0.7, 0.7), (0.7, 0.1, 0.08), (0.1, 0.6, 0.1)
     walls = [
@@ -89,20 +85,7 @@ def _interior(pos):
 
 
 def _ours_at(name, pos):
-    ob = bpy.data.objects[name + "_baked"]
-    me = ob.data
-    n = len(me.vertices)
-    co = np.empty(n * 3)
-    me.vertices.foreach_get("co", co)
-    mw = np.array(ob.matrix_world)
-    co = co.reshape(-1, 3) @ mw[:3, :3].T + mw[:3, 3]
-    col = np.empty(n * 4, dtype=np.float32)
-    me.color_attributes[ATTRIBUTE].data.foreach_get("color", col)
-    col = col.reshape(-1, 4)[:, :3].astype(np.float64)
-    d = np.linalg.norm(pos[:, None, :] - co[None, :, :], axis=2)
-    nearest = d.argmin(axis=1)
-    assert np.all(d[np.arange(len(pos)), nearest] < 1e-5), f"{name}: a grid vertex is not in the bake"
-    return col[nearest]
+    return cr.baked_colors_at(name, pos)
 
 
 @pytest.mark.parametrize("quality", ["MEDIUM"])
