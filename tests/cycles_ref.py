@@ -294,3 +294,20 @@ def noise_free_rel_rms(ours, a, b):
     noise = float(np.sum((a - b) ** 2)) / 4.0
     rms = np.sqrt(max(float(np.sum(e * e)) - noise, 0.0) / e.size) / ref.mean()
     return rms, np.sqrt(noise / e.size) / ref.mean()
+
+
+def add_block(lo, hi, color, name: str = "Block", material: str = "Block"):
+    """An axis-aligned box from ``lo`` to ``hi`` with outward faces and a Lambertian material."""
+    import bpy
+
+    (x0, y0, z0), (x1, y1, z1) = lo, hi
+    verts = [(x0, y0, z0), (x1, y0, z0), (x1, y1, z0), (x0, y1, z0),
+             (x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)]
+    faces = [(0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)]
+    me = bpy.data.meshes.new(name)
+    me.from_pydata(verts, [], faces)
+    me.update()
+    me.materials.append(diffuse_material(material, color))
+    ob = bpy.data.objects.new(name, me)
+    bpy.context.scene.collection.objects.link(ob)
+    return ob

@@ -37,17 +37,7 @@ def _floor():
 
 
 def _block():
-    (x0, y0, z0), (x1, y1, z1) = (-0.37, -0.29, 0.0), (0.21, 0.33, 0.45)
-    verts = [(x0, y0, z0), (x1, y0, z0), (x1, y1, z0), (x0, y1, z0),
-             (x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)]
-    faces = [(0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)]
-    me = bpy.data.meshes.new("Block")
-    me.from_pydata(verts, [], faces)
-    me.update()
-    me.materials.append(cr.diffuse_material("BlockMat", (0.5, 0.5, 0.5)))
-    ob = bpy.data.objects.new("Block", me)
-    bpy.context.scene.collection.objects.link(ob)
-    return ob
+    return cr.add_block((-0.37, -0.29, 0.0), (0.21, 0.33, 0.45), (0.5, 0.5, 0.5), material="BlockMat")
 
 
 def _panel():
@@ -79,28 +69,34 @@ def _ours_at(pos):
     return cr.baked_colors_at("Floor", pos)
 
 
-@pytest.mark.parametrize("indirect", [False, True])
-def test_emissive_panel_lights_the_floor_like_cycles(indirect):
+def compare_floor(build, indirect, tag):
+    """Cycles' floor (two seeds) against Penumbra's bake of the same scene, everything
+    selected, at the floor grid's vertices off its border and clear of the block; returns
+    the noise-free relative RMS and the reference's mean."""
     refs = []
     passes = {"DIRECT", "INDIRECT", "COLOR"} if indirect else {"DIRECT", "COLOR"}
     for seed in (1, 2):
-        floor, _, _ = _build(seed)
+        floor = build(seed)[0]
         refs.append(cr.bake_vertex_colors(floor, pass_filter=passes))
     (pos, a), (_, b) = refs
     for o in bpy.context.scene.objects:
         o.select_set(True)
     bpy.context.scene.penumbra.use_indirect = indirect
     assert bpy.ops.penumbra.bake() == {"FINISHED"}
-
-    # Off the floor's border and clear of the block's footprint and contact outline.
     m = 1e-6
     inner = (np.abs(pos[:, 0]) < SIDE / 2 - m) & (np.abs(pos[:, 1]) < SIDE / 2 - m)
     near_block = (pos[:, 0] > -0.40) & (pos[:, 0] < 0.24) & (pos[:, 1] > -0.32) & (pos[:, 1] < 0.36)
     keep = inner & ~near_block
-    ref = 0.5 * (a[keep] + b[keep])
     ours = _ours_at(pos[keep])
     rms, noise = cr.noise_free_rel_rms(ours, a[keep], b[keep])
-    print(f"\n[emitters] indirect={indirect} ours {ours.mean():.4f} Cycles {ref.mean():.4f} "
+    ref = 0.5 * (a[keep] + b[keep])
+    print(f"\n[{tag}] indirect={indirect} ours {ours.mean():.4f} Cycles {ref.mean():.4f} "
           f"rel RMS {rms:.4f} noise {noise:.4f}")
+    return rms, ref
+
+
+@pytest.mark.parametrize("indirect", [False, True])
+def test_emissive_panel_lights_the_floor_like_cycles(indirect):
+    rms, ref = compare_floor(_build, indirect, "emitters")
     assert ref.mean() > 0.01, "the panel must light the floor in Cycles"
     assert rms <= TOL

@@ -39,17 +39,7 @@ def _wall(name, origin, u, v, color):
 
 
 def _block(lo, hi, color):
-    (x0, y0, z0), (x1, y1, z1) = lo, hi
-    verts = [(x0, y0, z0), (x1, y0, z0), (x1, y1, z0), (x0, y1, z0),
-             (x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)]
-    faces = [(0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)]
-    me = bpy.data.meshes.new("Block")
-    me.from_pydata(verts, [], faces)
-    me.update()
-    me.materials.append(cr.diffuse_material("Block", color))
-    ob = bpy.data.objects.new("Block", me)
-    bpy.context.scene.collection.objects.link(ob)
-    return ob
+    return cr.add_block(lo, hi, color)
 
 
 def _build(seed):

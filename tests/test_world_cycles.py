@@ -7,11 +7,10 @@ two seeds taken out.
 """
 
 import bpy
-import numpy as np
 import pytest
 
 import cycles_ref as cr
-from test_emitters_cycles import GRID, SIDE, _block, _floor, _ours_at
+from test_emitters_cycles import _block, _floor, compare_floor
 
 SAMPLES = 1024
 TOL = 0.03
@@ -33,26 +32,7 @@ def _build(seed):
 
 @pytest.mark.parametrize("indirect", [False, True])
 def test_grey_world_lights_the_floor_like_cycles(indirect):
-    refs = []
-    passes = {"DIRECT", "INDIRECT", "COLOR"} if indirect else {"DIRECT", "COLOR"}
-    for seed in (1, 2):
-        floor, _ = _build(seed)
-        refs.append(cr.bake_vertex_colors(floor, pass_filter=passes))
-    (pos, a), (_, b) = refs
-    for o in bpy.context.scene.objects:
-        o.select_set(True)
-    bpy.context.scene.penumbra.use_indirect = indirect
-    assert bpy.ops.penumbra.bake() == {"FINISHED"}
-
-    m = 1e-6
-    inner = (np.abs(pos[:, 0]) < SIDE / 2 - m) & (np.abs(pos[:, 1]) < SIDE / 2 - m)
-    under = (pos[:, 0] > -0.38) & (pos[:, 0] < 0.22) & (pos[:, 1] > -0.30) & (pos[:, 1] < 0.34)
-    keep = inner & ~under
-    ref = 0.5 * (a[keep] + b[keep])
-    ours = _ours_at(pos[keep])
-    rms, noise = cr.noise_free_rel_rms(ours, a[keep], b[keep])
-    print(f"\n[world] indirect={indirect} ours {ours.mean():.4f} Cycles {ref.mean():.4f} "
-          f"rel RMS {rms:.4f} noise {noise:.4f}")
+    rms, ref = compare_floor(_build, indirect, "world")
     # An open floor under this world is albedo 0.6 × (0.5, 0.45, 0.4) × 2 where nothing hides it.
     assert ref.max() <= 0.6 * 1.0 * 1.02
     assert rms <= TOL

@@ -29,19 +29,7 @@ fn penumbra_values_match_rectangle_difference() {
     let mut n_pen = 0;
     for (v, c) in floor.positions.iter().zip(&floor.colors) {
         let (x, y) = (v[0], v[1]);
-        let full = rect(x, y, [-0.5, 0.5, -0.5, 0.5], 2.0);
-        // From (x, y, 0) the occluder at z = 1 hides light points l with (p + l)/2 inside it.
-        let hid = rect(
-            x,
-            y,
-            [
-                (-0.8 - x).max(-0.5),
-                (0.8 - x).min(0.5),
-                (-0.8 - y).max(-0.5),
-                (0.8 - y).min(0.5),
-            ],
-            2.0,
-        );
+        let (full, hid) = square_over_square(x, y);
         let want = radiance * (full - hid);
         let got = c[0] * PI;
         worst = worst.max((got - want).abs() / (radiance * full));

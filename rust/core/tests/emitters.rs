@@ -40,19 +40,7 @@ fn emissive_quad_lights_the_floor_like_an_area_light() {
     let mut worst: f64 = 0.0;
     for (v, c) in floor.positions.iter().zip(&floor.colors) {
         let (x, y) = (v[0], v[1]);
-        let full = rect(x, y, [-0.5, 0.5, -0.5, 0.5], 2.0);
-        // The occluder at z = 1 hides light points l with (p + l)/2 inside it.
-        let hid = rect(
-            x,
-            y,
-            [
-                (-0.8 - x).max(-0.5),
-                (0.8 - x).min(0.5),
-                (-0.8 - y).max(-0.5),
-                (0.8 - y).min(0.5),
-            ],
-            2.0,
-        );
+        let (full, hid) = square_over_square(x, y);
         // Lighting only: E / π.
         let want = le * (full - hid) / std::f64::consts::PI;
         worst = worst.max((c[0] - want).abs() / (le * full / std::f64::consts::PI));

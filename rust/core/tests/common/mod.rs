@@ -324,3 +324,22 @@ pub fn rect(px: f64, py: f64, [x0, x1, y0, y1]: [f64; 4], h: f64) -> f64 {
     let g = |x: f64, y: f64| signed_corner(x - px, y - py, h);
     g(x1, y1) - g(x0, y1) - g(x1, y0) + g(x0, y0)
 }
+
+/// The square-over-floor scene's closed form at the floor point (x, y, 0): the irradiance
+/// from the unit-radiance light [−0.5, 0.5]² at z = 2, and the part of it the occluder
+/// [−0.4, 0.4]² at z = 1 hides (light points l with (p + l)/2 inside the occluder).
+pub fn square_over_square(x: f64, y: f64) -> (f64, f64) {
+    let full = rect(x, y, [-0.5, 0.5, -0.5, 0.5], 2.0);
+    let hid = rect(
+        x,
+        y,
+        [
+            (-0.8 - x).max(-0.5),
+            (0.8 - x).min(0.5),
+            (-0.8 - y).max(-0.5),
+            (0.8 - y).min(0.5),
+        ],
+        2.0,
+    );
+    (full, hid)
+}
