@@ -7,7 +7,7 @@ world's node tree the way Cycles sees it: the Background node feeding the active
 Output, ``L = Color · Strength``. A textured world (an Environment or Image Texture on the
 colour) is taken as its image's mean colour, with one warning; anything else the Background
 does not hold (a sky texture, mixes of shaders) is a warning and the socket's own colour.
-A world without nodes lights with its plain ``color``.
+A world without nodes (before Blender 5) lights with its plain ``color``.
 """
 from __future__ import annotations
 
@@ -26,7 +26,9 @@ def world_radiance(world, warnings: list | None = None):
         return None
     where = f'World "{world.name}"'
     nt = getattr(world, "node_tree", None)
-    if nt is None or not getattr(world, "use_nodes", True):
+    # Blender 5 always uses the node tree (`use_nodes` is deprecated there and reading it
+    # warns); before 5, a world with nodes off lights with its plain colour.
+    if nt is None or (_before_blender_5() and not world.use_nodes):
         col = np.array(world.color[:3], dtype=np.float64)
         return _positive(col)
     outputs = [n for n in nt.nodes if n.bl_idname == "ShaderNodeOutputWorld"]
@@ -53,6 +55,14 @@ def world_radiance(world, warnings: list | None = None):
         col = _rgb(color_sock, warn, where)
     strength = _float(node.inputs["Strength"], warn, where)
     return _positive(col * strength)
+
+
+def _before_blender_5() -> bool:
+    try:
+        import bpy
+    except ImportError:  # outside Blender (unit tests of this module): a modern world
+        return False
+    return bpy.app.version < (5, 0, 0)
 
 
 def _positive(col):
