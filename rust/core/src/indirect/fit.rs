@@ -5,7 +5,7 @@
 
 use glam::DVec2;
 
-use super::blockers::Pair;
+use super::pair::Pair;
 use super::receiver::form_factor;
 use super::shooter::{Group, Shooter};
 use crate::geom::Plane;

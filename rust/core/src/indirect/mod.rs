@@ -29,6 +29,7 @@ pub(crate) mod coplanar_contacts;
 mod fit;
 mod gather;
 mod mls;
+mod pair;
 pub(crate) mod patches;
 mod receiver;
 mod shooter;

@@ -5,7 +5,7 @@ use std::f64::consts::PI;
 
 use glam::DVec3;
 
-use super::blockers::{Blockers, Pair};
+use super::pair::{Blockers, Pair};
 use super::shooter::{Group, Shooter};
 use super::{FEW_RAYS_BELOW, MAX_LISTED_OCCLUDERS, ONE_RAY_BELOW};
 use crate::geom::Plane;

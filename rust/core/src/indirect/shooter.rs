@@ -8,8 +8,8 @@ use std::sync::OnceLock;
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::blockers::{Blockers, Pair, Reached};
 use super::gather::Gather;
+use super::pair::{Blockers, Pair, Reached};
 use super::{mean, CHUNK, FACTOR_BUDGET};
 use crate::geom::raycast::Occluders;
 use crate::indirect::patches::Patch;
