@@ -34,19 +34,6 @@ fn epoch() -> Instant {
     *EPOCH.get_or_init(Instant::now)
 }
 
-/// The process's resident memory in bytes (Linux; `None` elsewhere).
-fn resident_bytes() -> Option<u64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let kb: u64 = status
-        .lines()
-        .find(|l| l.starts_with("VmRSS:"))?
-        .split_whitespace()
-        .nth(1)?
-        .parse()
-        .ok()?;
-    kb.checked_mul(1024)
-}
-
 impl Progress {
     pub fn new() -> Self {
         Self::default()
@@ -92,7 +79,7 @@ impl Progress {
 
     /// Arms the watchdog: from now on the process may grow by `bytes` (`max_memory`).
     pub fn watch_memory(&self, bytes: u64) {
-        if let Some(base) = resident_bytes() {
+        if let Some(base) = crate::scene::machine::resident_bytes() {
             self.base.store(base, Ordering::Relaxed);
             self.budget.store(bytes, Ordering::Relaxed);
         }
@@ -127,7 +114,7 @@ impl Progress {
         {
             return true;
         }
-        let Some(rss) = resident_bytes() else {
+        let Some(rss) = crate::scene::machine::resident_bytes() else {
             return true;
         };
         let grown = rss.saturating_sub(self.base.load(Ordering::Relaxed));
