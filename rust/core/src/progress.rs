@@ -1,8 +1,14 @@
 //! Progress reporting and cancellation, shared between a bake and whoever polls it
 //! (the CLI's progress bar, the Python binding's modal operator).
+//!
+//! It is also the memory watchdog: the resource model (`scene::resources`) refuses what it
+//! can foresee, and whatever it missed is caught here. Once armed with a budget, `check`
+//! looks at the process's resident memory at most every 50 ms; when it has grown by more
+//! than the budget since arming, the bake stops with a `max_memory` error (not a cancel).
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::Mutex;
+use std::sync::{Mutex, OnceLock};
+use std::time::Instant;
 
 use crate::BakeError;
 
@@ -11,6 +17,21 @@ pub struct Progress {
     stage: Mutex<&'static str>,
     fraction: AtomicU64,
     cancel: AtomicBool,
+    /// Bytes the process may grow by (0: no watchdog), from `base` resident bytes.
+    budget: AtomicU64,
+    base: AtomicU64,
+    /// Nanoseconds since `epoch()` before which `check` does not look at memory again.
+    next_look: AtomicU64,
+    /// Why the watchdog stopped the bake.
+    tripped: Mutex<Option<BakeError>>,
+}
+
+/// Memory is looked at no more often than this.
+const LOOK_EVERY_NS: u64 = 50_000_000;
+
+fn epoch() -> Instant {
+    static EPOCH: OnceLock<Instant> = OnceLock::new();
+    *EPOCH.get_or_init(Instant::now)
 }
 
 impl Progress {
@@ -43,12 +64,73 @@ impl Progress {
         self.cancel.load(Ordering::Relaxed)
     }
 
-    /// `Err(Cancelled)` once `cancel` was called: stages call this between units of work.
+    /// `Err(Cancelled)` once `cancel` was called, or the watchdog's error once the bake
+    /// has grown past its memory budget: stages call this between units of work.
     pub fn check(&self) -> Result<(), BakeError> {
+        if !self.is_cancelled() && !self.memory_ok() {
+            self.cancel();
+        }
         if self.is_cancelled() {
-            Err(BakeError::Cancelled)
+            Err(self.stopped_by().unwrap_or(BakeError::Cancelled))
         } else {
             Ok(())
         }
+    }
+
+    /// Arms the watchdog: from now on the process may grow by `bytes` (`max_memory`).
+    pub fn watch_memory(&self, bytes: u64) {
+        if let Some(base) = crate::scene::machine::resident_bytes() {
+            self.base.store(base, Ordering::Relaxed);
+            self.budget.store(bytes, Ordering::Relaxed);
+        }
+    }
+
+    /// The watchdog's error, when it stopped the bake.
+    pub fn stopped_by(&self) -> Option<BakeError> {
+        self.tripped
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .clone()
+    }
+
+    /// False once the process has grown by more than the budget (looked at every 50 ms).
+    fn memory_ok(&self) -> bool {
+        let budget = self.budget.load(Ordering::Relaxed);
+        if budget == 0 {
+            return true;
+        }
+        let now = epoch().elapsed().as_nanos() as u64;
+        let next = self.next_look.load(Ordering::Relaxed);
+        if now < next
+            || self
+                .next_look
+                .compare_exchange(
+                    next,
+                    now + LOOK_EVERY_NS,
+                    Ordering::Relaxed,
+                    Ordering::Relaxed,
+                )
+                .is_err()
+        {
+            return true;
+        }
+        let Some(rss) = crate::scene::machine::resident_bytes() else {
+            return true;
+        };
+        let grown = rss.saturating_sub(self.base.load(Ordering::Relaxed));
+        if grown <= budget {
+            return true;
+        }
+        let mib = |b: u64| b as f64 / (1u64 << 20) as f64;
+        *self.tripped.lock().unwrap_or_else(|e| e.into_inner()) = Some(BakeError::setting(
+            "max_memory",
+            format!(
+                "the bake grew by {:.0} MiB, over max_memory = {:.0} MiB, in stage \"{}\" (the estimate before baking missed it; raise max_memory or the element sizes)",
+                mib(grown),
+                mib(budget),
+                self.get().0
+            ),
+        ));
+        false
     }
 }

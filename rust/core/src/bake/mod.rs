@@ -107,13 +107,17 @@ pub fn bake_scene_json(text: &str, progress: &Progress) -> Result<Bake, BakeErro
 
 /// Bakes a validated scene on `settings.threads` threads (all cores by default).
 pub fn bake(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
+    progress.watch_memory(scene.settings.max_memory);
+    // A stage that sees the watchdog's cancel may report a plain `Cancelled`.
+    let stopped = |e: BakeError| progress.stopped_by().unwrap_or(e);
     match scene.settings.threads {
         Some(n) => rayon::ThreadPoolBuilder::new()
             .num_threads(n as usize)
             .build()
             .map_err(|e| BakeError::setting("threads", e.to_string()))?
-            .install(|| run(scene, progress)),
-        None => run(scene, progress),
+            .install(|| run(scene, progress))
+            .map_err(stopped),
+        None => run(scene, progress).map_err(stopped),
     }
 }
 
