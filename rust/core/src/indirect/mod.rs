@@ -128,7 +128,8 @@ fn indirect_at(
         el,
         settings.patch_size,
         settings.visibility_rays,
-    );
+        progress,
+    )?;
     let albedo = |p: &Patch| scene.faces[p.face as usize].albedo;
     // Emissive faces that are also area lights have sent their light as direct light.
     let mut emission: Vec<DVec3> = scene.faces.iter().map(|f| f.emission).collect();

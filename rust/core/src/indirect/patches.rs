@@ -12,7 +12,9 @@ use crate::geom::polygon::{
 };
 use crate::indirect::coplanar_contacts::Open;
 use crate::mesh::elements::Elements;
+use crate::progress::Progress;
 use crate::scene::Face;
+use crate::BakeError;
 
 #[derive(Debug, Clone)]
 pub struct Patch {
@@ -41,13 +43,16 @@ pub struct Patch {
 ///
 /// `open` is each face's uncovered part (`covered::open_parts`); triangles under a cover
 /// weigh in no patch.
+///
+/// Checks `progress` every few thousand triangles: a tiny `patch_size` makes this loop long.
 pub fn build_patches(
     faces: &[Face],
     open: &[Vec<Open>],
     el: &Elements,
     patch_size: f64,
     rays: u32,
-) -> Vec<Patch> {
+    progress: &Progress,
+) -> Result<Vec<Patch>, BakeError> {
     struct Piece {
         face: u32,
         cell: (u64, u64),
@@ -61,6 +66,9 @@ pub fn build_patches(
         .collect();
     let mut pieces: Vec<Piece> = Vec::with_capacity(el.triangles.len() * 2);
     for (t, tri) in el.triangles.iter().enumerate() {
+        if t % 4096 == 0 {
+            progress.check()?;
+        }
         let face = el.tri_face[t];
         let (f, grid) = (&faces[face as usize], &grids[face as usize]);
         let mut q = tri.map(|v| f.frame.to_2d(el.positions[v as usize]));
@@ -73,6 +81,10 @@ pub fn build_patches(
         let (tlo, thi) = bounds(&q);
         let mut overlaps = false;
         for j in lo.1..=hi.1 {
+            // One large triangle over a fine grid is a long loop of its own.
+            if (j - lo.1) % 64 == 63 {
+                progress.check()?;
+            }
             for i in lo.0..=hi.0 {
                 let in_cell = grid.clip(&q, (i, j));
                 if !(signed_area_2d(&in_cell) > 0.0) {
@@ -178,8 +190,9 @@ pub fn build_patches(
             patches.push(patch(face, f, &poly2, &members, el, rays, seed));
         }
         start = end;
+        progress.check()?;
     }
-    patches
+    Ok(patches)
 }
 
 /// The face's grid: `n` cells of size `cell` (at most `patch_size`, so that no sliver
@@ -498,7 +511,15 @@ pub(crate) mod test {
         let f = square(2.0);
         let el = grid_elements(std::slice::from_ref(&f), 8);
         // 2 / 0.7 → 3 cells a side of 2/3.
-        let p = build_patches(std::slice::from_ref(&f), &open_of(&f), &el, 0.7, 16);
+        let p = build_patches(
+            std::slice::from_ref(&f),
+            &open_of(&f),
+            &el,
+            0.7,
+            16,
+            &Progress::new(),
+        )
+        .unwrap();
         assert_eq!(p.len(), 9);
         let total: f64 = p.iter().map(|p| p.area).sum();
         assert!((total - 4.0).abs() < 1e-12);
@@ -535,7 +556,7 @@ pub(crate) mod test {
         let faces = [floor, bottom];
         let open = crate::indirect::coplanar_contacts::open_parts(&faces, 1e-9);
         let el = grid_elements(&faces, 8);
-        let p = build_patches(&faces, &open, &el, 2.0, 16);
+        let p = build_patches(&faces, &open, &el, 2.0, 16, &Progress::new()).unwrap();
         assert!(p.iter().all(|q| q.face == 0));
         let total: f64 = p.iter().map(|q| q.area).sum();
         assert!((total - 15.0).abs() < 1e-9, "{total}");
@@ -555,7 +576,15 @@ pub(crate) mod test {
             DVec3::ZERO,
         );
         let el = grid_elements(std::slice::from_ref(&f), 12);
-        let p = build_patches(std::slice::from_ref(&f), &open_of(&f), &el, 1.0, 9);
+        let p = build_patches(
+            std::slice::from_ref(&f),
+            &open_of(&f),
+            &el,
+            1.0,
+            9,
+            &Progress::new(),
+        )
+        .unwrap();
         let total: f64 = p.iter().map(|p| p.area).sum();
         assert!((total - 4.5).abs() < 1e-12);
         // Every patch holds elements; samples lie inside the face and on its plane.

@@ -679,7 +679,15 @@ fn fitted_far_groups_agree_with_vertex_by_vertex() {
     let el = grid_elements(&sc.faces, 40);
     let occ = Occluders::new(&sc.faces);
     let open = crate::indirect::coplanar_contacts::open_parts(&sc.faces, 1e-6 * sc.diagonal());
-    let patches = build_patches(&sc.faces, &open, &el, 0.5, sc.settings.visibility_rays);
+    let patches = build_patches(
+        &sc.faces,
+        &open,
+        &el,
+        0.5,
+        sc.settings.visibility_rays,
+        &Progress::new(),
+    )
+    .unwrap();
     let nv = el.positions.len();
     let fitted = Shooter::new(
         &sc,
