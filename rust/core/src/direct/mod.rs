@@ -69,6 +69,32 @@ pub fn direct_irradiance(
     Ok((e, counts))
 }
 
+/// Where to evaluate an area light for vertex `v` at `p`: `p` itself, unless `p` lies in the
+/// light's plane. That happens where a receiver meets an emissive face (`scene::emitters`):
+/// a floor vertex on the foot of a glowing wall sees the wall edge-on, so no light at all,
+/// where the floor a hair away gets plenty. A point a hair into the vertex's own face gives
+/// the limit that the elements around it show.
+fn on_light_plane(
+    scene: &Scene,
+    el: &Elements,
+    v: usize,
+    p: DVec3,
+    plane: &crate::geom::Plane,
+    tol: &Tolerances,
+) -> DVec3 {
+    if plane.dist(p).abs() > tol.flat {
+        return p;
+    }
+    let f = &scene.faces[el.vertex_face[v] as usize];
+    let centre = f.verts.iter().copied().sum::<DVec3>() / f.verts.len().max(1) as f64;
+    let d = centre - p;
+    let l = d.length();
+    if !(l > 0.0) {
+        return p;
+    }
+    p + d * ((1e-6 * l).max(100.0 * tol.flat).min(0.5 * l) / l)
+}
+
 fn vertex_direct(
     scene: &Scene,
     tol: &Tolerances,
@@ -155,7 +181,7 @@ fn vertex_direct(
                 plane,
                 radiance,
             } => exact::area_light(
-                p,
+                on_light_plane(scene, el, v, p, plane, tol),
                 n,
                 verts,
                 plane,
