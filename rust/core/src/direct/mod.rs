@@ -92,7 +92,7 @@ fn on_light_plane(
     if !(l > 0.0) {
         return p;
     }
-    p + d * ((1e-6 * l).max(100.0 * tol.flat).min(0.5 * l) / l)
+    p + d * (crate::geom::hair(l, 100.0 * tol.flat) / l)
 }
 
 fn vertex_direct(

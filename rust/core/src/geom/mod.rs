@@ -17,6 +17,14 @@ pub use plane::Plane;
 
 use glam::DVec3;
 
+/// How far to move a point lying on a surface's edge into the surface, `l` being its distance
+/// to a point well inside: far enough (`floor`, a few plane tolerances) that the point is off
+/// every plane it lay in, so it takes the limit of light from inside the surface; a millionth
+/// of the way otherwise, never past half of it.
+pub fn hair(l: f64, floor: f64) -> f64 {
+    (1e-6 * l).max(floor).min(0.5 * l)
+}
+
 /// A convex planar polygon in 3-D, as the visibility index (`raycast`) takes it.
 pub trait PlanarPolygon {
     fn verts(&self) -> &[DVec3];

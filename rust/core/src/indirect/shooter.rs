@@ -173,7 +173,7 @@ impl<'a> Shooter<'a> {
                 if !(l > 0.0) {
                     return *x;
                 }
-                let step = (1e-6 * l).max(100.0 * tol).min(0.5 * l);
+                let step = crate::geom::hair(l, 100.0 * tol);
                 let side = *e - *x;
                 if side.length() > 0.0 {
                     *x + side.normalize() * step
