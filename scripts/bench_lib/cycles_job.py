@@ -2,6 +2,7 @@
 
     python cycles_job.py bake  SCENE.json OUT.npz --spacing S --samples N --seed K
                                [--adaptive] [--direct-only] [--bounces B] [--threads T]
+                               [--mesh-spacing H]
     python cycles_job.py render SCENE.json OUT.png --samples N [--bake BAKE.json] ...
 
 Prints one JSON line: {"seconds": time of the bake (or render) call, "peak_rss_mb": ...}.
@@ -37,15 +38,22 @@ def main():
     ap.add_argument("--bake", help="render this bake JSON (emission) instead of the scene")
     ap.add_argument("--camera", help="JSON [[x,y,z],[tx,ty,tz],lens]")
     ap.add_argument("--resolution", type=int, default=200)
+    ap.add_argument("--mesh-spacing", type=float,
+                    help="bake a uniform mesh of this spacing and read the probes from it by "
+                    "linear interpolation (a Cycles user's vertex-colour bake)")
     a = ap.parse_args()
     scene = json.load(open(a.scene))
     blender.reset(a.samples, a.seed, a.adaptive, a.bounces, a.threads)
     if a.kind == "bake":
-        lat, _ = probes.scene_probes(scene, a.spacing)
-        objs = blender.cycles_scene(scene, lat)
+        lat, (pm, pp, px) = probes.scene_probes(scene, a.spacing)
+        mesh = probes.scene_probes(scene, a.mesh_spacing)[0] if a.mesh_spacing else lat
+        objs = blender.cycles_scene(scene, mesh)
         passes = {"DIRECT", "COLOR"} if a.direct_only else {"DIRECT", "INDIRECT", "COLOR"}
         dt, cols = blender.bake_vertex_colors(objs, passes)
-        probe = np.concatenate([c[l["probe"]] for c, l in zip(cols, lat)])
+        if a.mesh_spacing:
+            probe = probes.interpolate(mesh, cols, pm, pp, px)
+        else:
+            probe = np.concatenate([c[l["probe"]] for c, l in zip(cols, lat)])
         np.savez(a.out, colors=probe)
     else:
         import bpy

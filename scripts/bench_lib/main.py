@@ -20,7 +20,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.dirname(HERE))
 
-from bench_lib import errors, lightmap, penumbra_job, probes, report  # noqa: E402
+from bench_lib import errors, lightmap, penumbra_job, probes, report, uniform_cycles  # noqa: E402
 
 # Full scenes compared with Cycles (built-in scenes of the CLI). room-78 is the scaling
 # room with 78 boxes of clutter (60 + 12·78 = 996 furniture triangles).
@@ -50,6 +50,9 @@ class Config:
         self.lightmap_resolution = 64 if quick else 128
         self.lightmap_ref_samples = 256 if quick else 1024
         self.lightmap_ladder = [16, 64, 256] if quick else [16, 64, 256, 1024]
+        # Cycles on a uniform mesh: spacings (diagonal over these) × samples.
+        self.uniform_divisions = [25, 50] if quick else [25, 50, 100]
+        self.uniform_ladder = [16, 64] if quick else [16, 64, 256]
 
 
 def machine():
@@ -341,6 +344,10 @@ def main():
     ap.add_argument("--lightmap-only", action="store_true",
                     help="only the lightmap rows (Penumbra against Cycles' bake to an image); "
                     "writes OUT/lightmaps.json and their section of OUT/results.md and README.md")
+    ap.add_argument("--uniform-only", action="store_true",
+                    help="only Cycles on a uniform mesh (a vertex-colour user's bake) against "
+                    "Penumbra and Cycles at the probes; writes OUT/cycles_uniform.json and its "
+                    "section of OUT/results.md and README.md")
     a = ap.parse_args()
     if a.report_only and a.lightmap_only:
         with open(os.path.join(a.out, "lightmaps.json")) as f:
@@ -368,11 +375,20 @@ def main():
         rows = [lightmap.bench_scene(n, a.exe, sys.executable, a.work, cfg) for n in a.scenes]
         write_lightmaps(rows, machine(), command, a.out)
         return
+    if a.uniform_only:
+        command += " --uniform-only" + (f" --scenes {' '.join(a.scenes)}" if a.scenes != cfg.scenes
+                                        else "")
+        rows = [uniform_cycles.bench_scene(n, a.exe, sys.executable, a.work, cfg)
+                for n in a.scenes]
+        write_uniform(rows, machine(), command, a.out)
+        return
     res = dict(machine=machine(), quick=a.quick, config=vars(cfg), command=command, scenes={})
     res["lightmaps"] = []
     for name in a.scenes:
         bench_scene(name, a.exe, sys.executable, a.work, cfg, res["scenes"])
         res["lightmaps"].append(lightmap.bench_scene(name, a.exe, sys.executable, a.work, cfg))
+    res["cycles_uniform"] = [uniform_cycles.bench_scene(n, a.exe, sys.executable, a.work, cfg)
+                             for n in a.scenes]
     res["scaling"] = [] if a.no_scaling else scaling(a.exe, a.work, cfg)
     res["profile"] = profile(a.exe, a.work, a.scenes[-1])
     if "cornell" in a.scenes:
@@ -383,6 +399,7 @@ def main():
     text = report.write(res, a.out)
     print(text)
     write_lightmaps(res["lightmaps"], res["machine"], command, a.out)
+    write_uniform(res["cycles_uniform"], res["machine"], command, a.out)
 
 
 def write_lightmaps(rows, mach, command, out):
@@ -397,6 +414,21 @@ def write_lightmaps(rows, mach, command, out):
     lightmap.splice(md, text)
     if os.path.abspath(out) == os.path.join(ROOT, "bench"):
         lightmap.splice(os.path.join(ROOT, "README.md"), text)
+    print(text)
+
+
+def write_uniform(rows, mach, command, out):
+    """Cycles on a uniform mesh: OUT/cycles_uniform.json, and its section in OUT/results.md
+    and (for the repository's own bench/) README.md."""
+    with open(os.path.join(out, "cycles_uniform.json"), "w") as f:
+        json.dump(dict(machine=mach, command=command, scenes=rows), f, indent=1, default=float)
+    text = uniform_cycles.section(rows, mach, command)
+    md = os.path.join(out, "results.md")
+    if not os.path.exists(md):
+        open(md, "w").close()
+    uniform_cycles.splice(md, text)
+    if os.path.abspath(out) == os.path.join(ROOT, "bench"):
+        uniform_cycles.splice(os.path.join(ROOT, "README.md"), text)
     print(text)
 
 

@@ -86,6 +86,37 @@ def scene_probes(scene: dict, spacing: float):
     return meshes, (np.concatenate(pm), np.concatenate(pp), np.concatenate(px))
 
 
+def interpolate(lattices: list[dict], colors: list[np.ndarray], probe_mesh, probe_poly,
+                probe_pos) -> np.ndarray:
+    """Values at the probes read from vertex colours on other lattices (a uniform mesh a
+    Cycles user would bake): linear over the lattice triangle of the probe's polygon that
+    holds it, as a viewport shows a vertex-colour bake. NaN where no triangle holds it."""
+    out = np.full((len(probe_pos), 3), np.nan)
+    for mi, (lat, col) in enumerate(zip(lattices, colors)):
+        V, T = lat["verts"], lat["tris"]
+        tri_poly = lat["polygon"][T[:, 0]]
+        for pi in np.unique(probe_poly[probe_mesh == mi]):
+            sel = np.nonzero((probe_mesh == mi) & (probe_poly == pi))[0]
+            tris = T[tri_poly == pi]
+            a, b, c = V[tris[:, 0]], V[tris[:, 1]], V[tris[:, 2]]
+            n = np.cross(b - a, c - a)
+            nn = np.einsum("ij,ij->i", n, n)
+            x = probe_pos[sel][:, None, :]  # (P, 1, 3)
+            # Barycentric coordinates of every probe in every triangle of the polygon.
+            wb = np.einsum("ptk,tk->pt", np.cross(x - a, c - a), n) / nn
+            wc = np.einsum("ptk,tk->pt", np.cross(b - a, x - a), n) / nn
+            wa = 1.0 - wb - wc
+            inside = np.minimum(np.minimum(wa, wb), wc)
+            best = np.argmax(inside, axis=1)
+            k = np.arange(len(sel))
+            ok = inside[k, best] > -1e-6
+            t = tris[best]
+            val = (wa[k, best, None] * col[t[:, 0]] + wb[k, best, None] * col[t[:, 1]]
+                   + wc[k, best, None] * col[t[:, 2]])
+            out[sel[ok]] = val[ok]
+    return out
+
+
 def scene_diagonal(scene: dict) -> float:
     """Bounding-box diagonal of meshes and lights, as the core computes it for defaults."""
     pts = [np.asarray(m["positions"], dtype=np.float64) for m in scene["meshes"]]

@@ -1,0 +1,51 @@
+"""The bench reads a Cycles user's uniform-mesh bake at the probes by linear interpolation
+(`bench_lib.probes.interpolate`): a field linear over each polygon comes back exactly, and a
+probe no triangle holds stays NaN instead of taking a neighbour's value."""
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                                "scripts"))
+
+from bench_lib import probes  # noqa: E402
+
+
+def _scene():
+    # A floor quad and a tilted triangle, as scene JSON.
+    return {"meshes": [
+        {"name": "Floor", "positions": [[0, 0, 0], [2, 0, 0], [2, 1, 0], [0, 1, 0]],
+         "polygons": [[0, 1, 2, 3]]},
+        {"name": "Tilt", "positions": [[0, 0, 1], [1, 0, 1.5], [0, 1, 2]],
+         "polygons": [[0, 1, 2]]}], "lights": []}
+
+
+def test_linear_field_is_read_exactly_at_probes_off_the_mesh_vertices():
+    scene = _scene()
+    _, (pm, pp, px) = probes.scene_probes(scene, 0.3)
+    fine = probes.scene_probes(scene, 0.083)[0]
+
+    def field(x):
+        return np.stack([1 + 2 * x[:, 0], x[:, 1] - 3 * x[:, 2], 0.5 * x[:, 2] + 0.1], axis=1)
+
+    y = probes.interpolate(fine, [field(m["verts"]) for m in fine], pm, pp, px)
+    assert len(px) > 10
+    assert not np.isnan(y).any()
+    np.testing.assert_allclose(y, field(px), atol=1e-12)
+    # The probes are not lattice vertices of the finer mesh: interpolation did the work.
+    fv = np.concatenate([m["verts"] for m in fine])
+    d = np.min(np.linalg.norm(px[:, None, :] - fv[None, :, :], axis=2), axis=1)
+    assert (d > 1e-6).sum() > len(px) // 2
+
+
+def test_a_probe_outside_its_polygon_stays_nan():
+    scene = _scene()
+    fine = probes.scene_probes(scene, 0.1)[0]
+    cols = [np.ones((len(m["verts"]), 3)) for m in fine]
+    pm = np.array([0, 0])
+    pp = np.array([0, 0])
+    px = np.array([[0.5, 0.5, 0.0], [3.0, 0.5, 0.0]])
+    y = probes.interpolate(fine, cols, pm, pp, px)
+    np.testing.assert_allclose(y[0], 1.0)
+    assert np.isnan(y[1]).all()
