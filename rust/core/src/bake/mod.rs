@@ -142,6 +142,19 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
     progress.stage("discontinuity loops");
     progress.check()?;
     let t = Instant::now();
+    // Scenery (a mesh without output) is there only to shadow and reflect light to the
+    // outputs: when indirect light needs its elements, a uniform mesh at the element size
+    // will do, without discontinuity edges or fine penumbra elements (a large unselected
+    // room around a baked chair would otherwise cost most of the bake). Its vertices' direct
+    // light stays exact; what it reflects is smeared over an element across its shadow
+    // edges (3 % on a box's underside lit only by a scenery floor, tests/scope.rs).
+    let scenery =
+        |f: &crate::scene::Face| scene.settings.indirect && !scene.meshes[f.mesh as usize].output;
+    let scenery_settings = crate::scene::settings::Settings {
+        uniform: true,
+        penumbra_element_size: scene.settings.element_size,
+        ..scene.settings.clone()
+    };
     // The first `Cancelled` stops rayon handing out receivers; a large receiver's
     // arrangement checks on its own.
     let built: Vec<(ReceiverRegions, RegionTimes)> = scene
@@ -150,7 +163,7 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
         .zip(shadows)
         .map(|(f, sh)| {
             progress.check()?;
-            let uniform = scene.settings.uniform;
+            let uniform = scene.settings.uniform || scenery(f);
             regions::build_regions(f, sh, &tol, uniform, keep_contacts, progress)
         })
         .collect::<Result<_, BakeError>>()?;
@@ -186,8 +199,13 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
             if !scene.meshes[f.mesh as usize].output && !scene.settings.indirect {
                 return Ok(ReceiverMesh::default());
             }
-            let sizing = Sizing::new(f, &scene.lights, &scene.settings);
-            mesh::mesh_receiver(rr, &sizing, &scene.settings, &tol, &budget, progress)
+            let settings = if scenery(f) {
+                &scenery_settings
+            } else {
+                &scene.settings
+            };
+            let sizing = Sizing::new(f, &scene.lights, settings);
+            mesh::mesh_receiver(rr, &sizing, settings, &tol, &budget, progress)
         })
         .collect::<Result<_, _>>()?;
     let elements = assemble(scene, &meshes);
