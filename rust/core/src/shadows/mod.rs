@@ -9,6 +9,7 @@ pub mod culling;
 pub mod plane_cuts;
 pub mod polygons;
 pub mod round;
+pub mod spot_cone;
 pub mod umbra_pruning;
 pub mod volume;
 
@@ -436,6 +437,15 @@ fn receiver_polygons(
                 }
             }
         }
+    }
+    if let LightKind::Point {
+        position,
+        spot: Some(spot),
+        ..
+    } = kind
+    {
+        let band = scene.settings.penumbra_element_size;
+        spot_cone::cone_edges(*position, spot, r, band, &mut events);
     }
     OnReceiver {
         exposure: Exposure::Regions,
