@@ -115,6 +115,62 @@ fn sun_with_an_angle_penumbra() {
     assert!(partial > 50, "{partial}");
 }
 
+/// A point light inside a closed room: the walls around it are too large seen from the light
+/// for one proxy disc (they take the cube's faces instead), and still every floor vertex gets
+/// exactly the disc's visible light.
+#[test]
+fn soft_point_light_in_a_room() {
+    let room = penumbra::scenes::cuboid([-2., -2., 0.], [2., 2., 2.6], true);
+    let box_polys = cuboid([-0.5, -0.5, 0.2], [0.5, 0.5, 1.0]);
+    let floor = room[0].clone();
+    let s = scene(
+        vec![
+            mesh("Floor", vec![floor]),
+            mesh("Walls", room[1..].to_vec()),
+            mesh("Box", box_polys.clone()),
+        ],
+        vec![LightJson {
+            name: "Bulb".into(),
+            point: Some([0.3, 0.2, 2.0]),
+            intensity: Some([10.0; 3]),
+            radius: Some(0.2),
+            ..Default::default()
+        }],
+        settings(),
+    );
+    let sc = penumbra::scene::validate(&s).unwrap();
+    let b = bake(&s);
+    let occ: Vec<Vec<DVec3>> = box_polys
+        .iter()
+        .chain(&room[1..])
+        .map(|p| p.iter().map(|v| DVec3::from_array(*v)).collect())
+        .collect();
+    let blockers: Vec<&[DVec3]> = occ.iter().map(|o| o.as_slice()).collect();
+    let kind = &sc.lights[0].kind;
+    let (mut worst, mut peak) = (0.0f64, 0.0f64);
+    for (v, c) in b.meshes[0].positions.iter().zip(&b.meshes[0].colors) {
+        let p = DVec3::from_array(*v);
+        let disc = facing(kind, p, 100.0).unwrap();
+        let e = |rel, b: &[&[DVec3]]| {
+            round_light(
+                p,
+                DVec3::Z,
+                kind,
+                &disc,
+                rel,
+                b,
+                PenumbraVisibility::Exact,
+                0,
+            )
+            .x
+        };
+        peak = peak.max(e(Relation::Lit, &[]) / PI);
+        worst = worst.max((c[0] - e(Relation::Penumbra, &blockers) / PI).abs());
+    }
+    assert!(worst < 1e-9 * peak, "{}", worst / peak);
+    assert!(b.meshes[0].relation.iter().any(|r| r[0] == 2));
+}
+
 #[test]
 fn a_sun_angle_or_a_sphere_where_it_does_not_belong_is_refused() {
     let bad = [

@@ -148,9 +148,16 @@ pub fn shadow_polygons(
                     return Vec::new();
                 }
                 match proxies.as_ref().map(|p| p.get(oi as u32)) {
-                    Some(Some(k)) => occluder_volumes(k, None, oi as u32, o, faces, eps),
+                    Some(round::Stand::Disc(k)) => {
+                        occluder_volumes(k, None, oi as u32, o, faces, eps)
+                    }
+                    Some(round::Stand::Cube(ks)) => ks
+                        .iter()
+                        .flat_map(|k| occluder_volumes(k, None, oi as u32, o, faces, eps))
+                        .map(|v| ShadowVolumes { umbra: None, ..v })
+                        .collect(),
                     // Too near a round light for a proxy: its penumbra may be anywhere.
-                    Some(None) => vec![ShadowVolumes {
+                    Some(round::Stand::Everywhere) => vec![ShadowVolumes {
                         occluder: oi as u32,
                         penumbra: vec![Volume::default()],
                         umbra: None,
@@ -189,7 +196,7 @@ pub fn shadow_polygons(
             .map(|(oi, rs)| {
                 let own = |f: u32| scene.face_occluder[f as usize] as usize == oi;
                 let light_points = match proxies.as_ref().map(|p| p.get(oi as u32)) {
-                    Some(Some(LightKind::Area { verts, .. })) => verts.as_slice(),
+                    Some(round::Stand::Disc(LightKind::Area { verts, .. })) => verts.as_slice(),
                     Some(_) => &[],
                     None => light_points.as_slice(),
                 };
@@ -384,12 +391,12 @@ fn receiver_polygons(
         let recomputed;
         // A round light's proxy disc (`round`), cut to this receiver's front like an area
         // light: the part behind holds no ray from the receiver to the round light.
-        let (kind, clipped_light) = match proxies.and_then(|p| p.get(oi)) {
-            Some(pk) => match light_in_front(pk, r, eps) {
+        let (kind, clipped_light) = match proxies.map(|p| p.get(oi)) {
+            Some(round::Stand::Disc(pk)) => match light_in_front(pk, r, eps) {
                 None => continue,
                 Some(c) => (pk, c),
             },
-            None => (kind, clipped_light.clone()),
+            _ => (kind, clipped_light.clone()),
         };
         let svs: &[ShadowVolumes] = match &clipped_light {
             None => &volumes[oi as usize],
