@@ -1,7 +1,8 @@
 """Soft shadows of round lights, baked by the add-on and by Cycles (issue 14).
 
 A floor grid under a block, lit by one light with a size: a point light of radius 0.2 (soft
-falloff, Blender's default: a disc facing each point; and a sphere), and a sun of angle 5°.
+falloff, Blender's default: a disc facing each point; and a sphere), a spot of radius 0.15
+whose cone edge crosses the floor, and a sun of angle 5°.
 Cycles shadows them with a penumbra; Penumbra clips the disc facing each point against the
 block and meshes the penumbra. Compared with the direct pass (indirect light off) at the
 floor grid's interior vertices (vertices of Penumbra's output too), Cycles' noise from two
@@ -44,6 +45,10 @@ LIGHTS = {
     "point_r0.2": ("POINT", dict(location=(0.3, -0.2, 1.6)), dict(energy=60.0, shadow_soft_size=0.2)),
     "sphere_r0.2": ("POINT", dict(location=(0.3, -0.2, 1.6)),
                     dict(energy=60.0, shadow_soft_size=0.2, use_soft_falloff=False)),
+    # A spot of radius 0.15: Cycles applies the cone mask per point of the disc, so the disc
+    # blurs the cone's edge (which crosses the floor inside the grid).
+    "spot_r0.15": ("SPOT", dict(location=(0.3, -0.2, 1.6)),
+                   dict(energy=60.0, shadow_soft_size=0.15, spot_size=math.radians(70.0), spot_blend=0.1)),
     "sun_5deg": ("SUN", dict(rotation=(0.55, -0.35, 0.0)), dict(energy=3.0, angle=math.radians(5.0))),
 }
 

@@ -210,16 +210,21 @@ fn vertex_direct(
                 spot,
                 ..
             } => match &disc {
-                Some(d) => {
-                    let mask = spot
-                        .as_ref()
-                        .map_or(1.0, |s| exact::spot_mask(s, p - *position));
-                    if mask > 0.0 {
-                        mask * round_light(p, n, &light.kind, d, relation, &simple_polys, scene)
-                    } else {
-                        DVec3::ZERO
-                    }
-                }
+                Some(d) => match spot {
+                    Some(s) => round::round_spot(
+                        p,
+                        n,
+                        &light.kind,
+                        d,
+                        s,
+                        *position,
+                        relation,
+                        &simple_polys,
+                        scene.settings.penumbra_visibility,
+                        scene.settings.penumbra_samples,
+                    ),
+                    None => round_light(p, n, &light.kind, d, relation, &simple_polys, scene),
+                },
                 None => {
                     exact::point_light(p, n, *position, *intensity, spot.as_ref(), relation, &polys)
                 }

@@ -448,11 +448,12 @@ fn receiver_polygons(
     if let LightKind::Point {
         position,
         spot: Some(spot),
+        radius,
         ..
     } = kind
     {
         let band = scene.settings.penumbra_element_size;
-        spot_cone::cone_edges(*position, spot, r, band, &mut events);
+        spot_cone::cone_edges(*position, spot, *radius, r, band, &mut events);
     }
     OnReceiver {
         exposure: Exposure::Regions,

@@ -19,14 +19,29 @@ use crate::scene::{Face, Spot};
 pub const CONE_SIDES: usize = 256;
 
 /// The cone-edge segments of a spot at `apex` on receiver `r` (2-D, in `r`'s frame), `band`
-/// the width of the band standing for a hard edge.
-pub fn cone_edges(apex: DVec3, spot: &Spot, r: &Face, band: f64, out: &mut Vec<[DVec2; 2]>) {
+/// the width of the band standing for a hard edge. A spot of `radius` > 0 (a disc, whose mask
+/// is averaged over the disc: `direct::round::spot_over_disc`) gets the conics bounding the
+/// blurred band instead.
+pub fn cone_edges(
+    apex: DVec3,
+    spot: &Spot,
+    radius: f64,
+    r: &Face,
+    band: f64,
+    out: &mut Vec<[DVec2; 2]>,
+) {
     let h = r.plane.dist(apex);
     if !(h > 0.0) {
         return;
     }
     let outer = spot.cos_half_angle.clamp(-1.0, 1.0).acos();
-    let angles: Vec<f64> = if spot.blend > 0.0 {
+    let angles: Vec<f64> = if radius > 0.0 {
+        // A round spot: the disc blurs the mask over its own angular size, largest at the
+        // receiver's point nearest the light; the light is smooth between these two.
+        let a = (radius / h).atan();
+        let inner = spot.cos_half_angle + (1.0 - spot.cos_half_angle) * spot.blend;
+        vec![inner.clamp(-1.0, 1.0).acos() - a, outer + a]
+    } else if spot.blend > 0.0 {
         let inner = spot.cos_half_angle + (1.0 - spot.cos_half_angle) * spot.blend;
         vec![outer, inner.clamp(-1.0, 1.0).acos()]
     } else {

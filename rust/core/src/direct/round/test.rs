@@ -114,3 +114,90 @@ fn the_penumbra_grows_with_the_radius() {
         assert_eq!(umbra, 0.0);
     }
 }
+
+#[test]
+fn a_round_spot_blurs_its_cone_edge_over_the_disc() {
+    use crate::scene::Spot;
+    let apex = DVec3::new(0.0, 0.0, 2.0);
+    let spot = Spot {
+        direction: -DVec3::Z,
+        cos_half_angle: 30f64.to_radians().cos(),
+        blend: 0.0,
+    };
+    let kind = LightKind::Point {
+        position: apex,
+        intensity: DVec3::ONE,
+        spot: None,
+        radius: 0.1,
+        sphere: false,
+    };
+    let at = |x: f64| {
+        let p = DVec3::new(x, 0.0, 0.0);
+        let disc = facing(&kind, p, 20.0).unwrap();
+        let all = eval(&kind, p, Lit, &[], true).x;
+        let e = round_spot(p, DVec3::Z, &kind, &disc, &spot, apex, Lit, &[], Exact, 0).x;
+        e / all
+    };
+    let edge = 2.0 * 30f64.to_radians().tan();
+    // Far inside and outside: the mask itself, no quadrature.
+    assert!((at(0.5 * edge) - 1.0).abs() < 1e-15);
+    assert_eq!(at(1.5 * edge), 0.0);
+    // On the edge the cone's boundary halves the disc (nearly: it is a conic, not a line).
+    let half = at(edge);
+    assert!((half - 0.5).abs() < 0.02, "{half}");
+    // Monotone across the blurred band.
+    let xs: Vec<f64> = (0..21)
+        .map(|k| at(edge * (0.85 + 0.015 * k as f64)))
+        .collect();
+    assert!(xs.windows(2).all(|w| w[1] <= w[0]), "{xs:?}");
+    assert!(xs[0] > 0.99 && xs[20] < 0.01, "{xs:?}");
+}
+
+#[test]
+fn a_shadow_edge_across_a_round_spot_s_cone_edge() {
+    use crate::scene::Spot;
+    // Hard cone of 30° from (0, 0, 2) straight down; from the point on its edge the disc's
+    // outer half (x > 0) is inside the cone (its directions to p are steeper), and a half-plane
+    // at height 1 through the line of sight hides exactly that half: almost nothing is left,
+    // where the product of the two halves would give a quarter.
+    let apex = DVec3::new(0.0, 0.0, 2.0);
+    let spot = Spot {
+        direction: -DVec3::Z,
+        cos_half_angle: 30f64.to_radians().cos(),
+        blend: 0.0,
+    };
+    let kind = LightKind::Point {
+        position: apex,
+        intensity: DVec3::ONE,
+        spot: None,
+        radius: 0.1,
+        sphere: false,
+    };
+    let edge = 2.0 * 30f64.to_radians().tan();
+    let p = DVec3::new(edge, 0.0, 0.0);
+    let occ: Vec<DVec3> = [
+        (0.5 * edge, -50.0),
+        (50.0, -50.0),
+        (50.0, 50.0),
+        (0.5 * edge, 50.0),
+    ]
+    .iter()
+    .map(|&(x, y)| DVec3::new(x, y, 1.0))
+    .collect();
+    let disc = facing(&kind, p, 20.0).unwrap();
+    let all = eval(&kind, p, Lit, &[], true).x;
+    let e = round_spot(
+        p,
+        DVec3::Z,
+        &kind,
+        &disc,
+        &spot,
+        apex,
+        Penumbra,
+        &[&occ],
+        Exact,
+        0,
+    )
+    .x;
+    assert!(e / all < 0.05, "{}", e / all);
+}
