@@ -206,3 +206,22 @@ fn a_sun_angle_or_a_sphere_where_it_does_not_belong_is_refused() {
         assert!(e.contains(field), "{e}");
     }
 }
+
+/// The bench's scene of round lights in an unbaked room: the walls get no triangles, and
+/// every light casts a penumbra on the outputs.
+#[test]
+fn the_mixed_bench_scene_bakes() {
+    let mut s = penumbra::scenes::by_name("mixed").expect("built-in");
+    s.settings.indirect = Some(false);
+    let b = bake(&s);
+    assert_eq!(b.meshes[0].name, "Room");
+    assert!(b.meshes[0].triangles.is_empty());
+    for li in 0..s.lights.len() {
+        assert!(
+            b.meshes[1..]
+                .iter()
+                .any(|m| m.relation.iter().any(|r| r[li] == 2)),
+            "light {li} casts no penumbra"
+        );
+    }
+}
