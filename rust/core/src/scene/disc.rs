@@ -51,7 +51,19 @@ impl Disc {
     pub fn polygon(&self) -> Vec<DVec3> {
         let n = DISC_SIDES as f64;
         let tau = std::f64::consts::TAU;
-        let big = self.radius * (tau / (n * (tau / n).sin())).sqrt();
+        self.regular(self.radius * (tau / (n * (tau / n).sin())).sqrt())
+    }
+
+    /// The regular [`DISC_SIDES`]-gon around the disc (its edges touch the circle): a proxy
+    /// must hold the whole disc.
+    pub fn circumscribed(&self) -> Vec<DVec3> {
+        self.regular(self.radius / (std::f64::consts::PI / DISC_SIDES as f64).cos())
+    }
+
+    /// The regular [`DISC_SIDES`]-gon of circumradius `big`, counter-clockwise about `normal`.
+    fn regular(&self, big: f64) -> Vec<DVec3> {
+        let n = DISC_SIDES as f64;
+        let tau = std::f64::consts::TAU;
         let f = Frame::new(self.centre, self.normal);
         (0..DISC_SIDES)
             .map(|k| {
@@ -65,10 +77,10 @@ impl Disc {
         Plane::from_point_normal(self.centre, self.normal)
     }
 
-    /// The disc as an area light (its polygon) for the shadow stage's volumes.
+    /// The disc as an area light (the polygon around it) for the shadow stage's volumes.
     pub fn area_light(&self) -> LightKind {
         LightKind::Area {
-            verts: self.polygon(),
+            verts: self.circumscribed(),
             plane: self.plane(),
             radiance: self.radiance,
         }

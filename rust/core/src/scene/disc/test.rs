@@ -206,11 +206,22 @@ fn the_proxy_disc_holds_every_shadowed_point_s_cone() {
                 continue;
             }
             shadowed += 1;
-            for l in &rim {
-                let w = *l - p;
-                let t = -plane.dist(p) / plane.n.dot(w);
-                let x = p + w * t;
+            // Every ray to the point's own disc (its rim, sampled finely) meets the proxy's
+            // plane inside the disc of the proxy's radius, and so inside its polygon.
+            let fine = Frame::new(disc.centre, disc.normal);
+            let proxy_poly = px.circumscribed();
+            for k in 0..720 {
+                let t = std::f64::consts::TAU * k as f64 / 720.0;
+                let l = fine.to_3d(DVec2::new(disc.radius * t.cos(), disc.radius * t.sin()));
+                let w = l - p;
+                let s = -plane.dist(p) / plane.n.dot(w);
+                let x = p + w * s;
                 assert!((x - px.centre).length() <= px.radius * (1.0 + 1e-9));
+                let inside = (0..DISC_SIDES).all(|i| {
+                    let (a, b) = (proxy_poly[i], proxy_poly[(i + 1) % DISC_SIDES]);
+                    (b - a).cross(x - a).dot(px.normal) >= 0.0
+                });
+                assert!(inside);
             }
         }
         assert!(shadowed > 200, "{shadowed}");
