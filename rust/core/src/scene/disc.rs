@@ -30,6 +30,11 @@ use crate::geom::{Frame, Plane};
 /// closed form), for a disc small seen from the point.
 pub const DISC_SIDES: usize = 48;
 
+/// Sides of the shadow stage's proxy polygon, circumscribed about the proxy disc: its corners
+/// reach 2 % beyond the disc (1/cos(π/16)), a penumbra that much wider, where 48 sides would
+/// triple every proxy's shadow volumes (an umbra volume has planes per light vertex).
+pub const PROXY_SIDES: usize = 16;
+
 /// How far (in scene diagonals) the shadow stage puts a sun's disc; the disc is enlarged by
 /// the scene's size so that every point's own cone stays inside it (about 1/1000 of its
 /// radius per diagonal).
@@ -51,21 +56,25 @@ impl Disc {
     pub fn polygon(&self) -> Vec<DVec3> {
         let n = DISC_SIDES as f64;
         let tau = std::f64::consts::TAU;
-        self.regular(self.radius * (tau / (n * (tau / n).sin())).sqrt())
+        self.regular(
+            DISC_SIDES,
+            self.radius * (tau / (n * (tau / n).sin())).sqrt(),
+        )
     }
 
-    /// The regular [`DISC_SIDES`]-gon around the disc (its edges touch the circle): a proxy
+    /// The regular [`PROXY_SIDES`]-gon around the disc (its edges touch the circle): a proxy
     /// must hold the whole disc.
     pub fn circumscribed(&self) -> Vec<DVec3> {
-        self.regular(self.radius / (std::f64::consts::PI / DISC_SIDES as f64).cos())
+        let n = PROXY_SIDES;
+        self.regular(n, self.radius / (std::f64::consts::PI / n as f64).cos())
     }
 
-    /// The regular [`DISC_SIDES`]-gon of circumradius `big`, counter-clockwise about `normal`.
-    fn regular(&self, big: f64) -> Vec<DVec3> {
-        let n = DISC_SIDES as f64;
+    /// A regular `sides`-gon of circumradius `big`, counter-clockwise about `normal`.
+    fn regular(&self, sides: usize, big: f64) -> Vec<DVec3> {
+        let n = sides as f64;
         let tau = std::f64::consts::TAU;
         let f = Frame::new(self.centre, self.normal);
-        (0..DISC_SIDES)
+        (0..sides)
             .map(|k| {
                 let t = tau * k as f64 / n;
                 f.to_3d(DVec2::new(big * t.cos(), big * t.sin()))

@@ -25,8 +25,11 @@ pub enum Stand {
     Everywhere,
 }
 
-/// Per occluder, what stands in for a round light.
-pub struct Proxies(Vec<Stand>);
+/// Per occluder, what stands in for a round light (a sun's one disc is shared by all).
+pub enum Proxies {
+    Shared(Stand),
+    PerOccluder(Vec<Stand>),
+}
 
 impl Proxies {
     /// `None` for a light that is not round.
@@ -36,6 +39,12 @@ impl Proxies {
         }
         let centre = 0.5 * (scene.bounds_min + scene.bounds_max);
         let diag = scene.diagonal();
+        if let LightKind::Sun { .. } = kind {
+            return Some(Proxies::Shared(match proxy(kind, &[], 0.0, centre, diag) {
+                Proxy::Disc(d) => Stand::Disc(d.area_light()),
+                Proxy::Everywhere => Stand::Everywhere,
+            }));
+        }
         let nearest = |occ: &Occluder, c: DVec3| {
             occ.faces()
                 .iter()
@@ -65,11 +74,14 @@ impl Proxies {
                 }
             })
             .collect();
-        Some(Proxies(per))
+        Some(Proxies::PerOccluder(per))
     }
 
     pub fn get(&self, oi: u32) -> &Stand {
-        &self.0[oi as usize]
+        match self {
+            Proxies::Shared(s) => s,
+            Proxies::PerOccluder(v) => &v[oi as usize],
+        }
     }
 }
 

@@ -217,8 +217,8 @@ fn the_proxy_disc_holds_every_shadowed_point_s_cone() {
                 let s = -plane.dist(p) / plane.n.dot(w);
                 let x = p + w * s;
                 assert!((x - px.centre).length() <= px.radius * (1.0 + 1e-9));
-                let inside = (0..DISC_SIDES).all(|i| {
-                    let (a, b) = (proxy_poly[i], proxy_poly[(i + 1) % DISC_SIDES]);
+                let inside = (0..PROXY_SIDES).all(|i| {
+                    let (a, b) = (proxy_poly[i], proxy_poly[(i + 1) % PROXY_SIDES]);
                     (b - a).cross(x - a).dot(px.normal) >= 0.0
                 });
                 assert!(inside);
