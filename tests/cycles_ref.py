@@ -193,8 +193,10 @@ def irradiance_point(points, normal, light):
     r2 = np.sum(d * d, axis=1)
     r = np.sqrt(r2)
     cos_r = np.maximum(d @ n / r, 0.0)
-    # With a radius: Blender's soft falloff, a disk facing the receiver.
-    f = cos_r / (r2 + float(light.get("radius", 0.0)) ** 2)
+    # With a radius: Blender's soft falloff, a disk facing the receiver; a sphere
+    # (``"sphere": true``) lights like a point at its centre.
+    soft = 0.0 if light.get("sphere", False) else float(light.get("radius", 0.0))
+    f = cos_r / (r2 + soft ** 2)
     spot = light.get("spot")
     if spot is not None:
         sd = np.asarray(spot["direction"], dtype=np.float64)

@@ -4,7 +4,8 @@
   are the probe lattices (same geometry, more vertices), with a Diffuse BSDF of the
   polygon's albedo (plus an Emission of its emission radiance). Rectangular light polygons
   become RECTANGLE area lights of power P = L·π·A (Blender's convention L = P/(π·A), see
-  addon/penumbra/io/lights.py); other polygons become one-sided emissive faces.
+  addon/penumbra/io/lights.py); other polygons become one-sided emissive faces. Point,
+  spot and sun lights become Blender lights of those types (radius, angle, cone).
 * `baked_scene`: a bake JSON as meshes with an emission shader reading the colour
   attribute, for rendering what Penumbra baked.
 """
@@ -123,8 +124,47 @@ def cycles_scene(scene: dict, lattices: list[dict]):
         if "polygon" in l:
             _light(l, i)
         else:
-            raise ValueError(f"bench: light {l['name']!r}: only polygon lights are benchmarked")
+            _point_or_sun(l)
     return objs
+
+
+def _point_or_sun(l):
+    """A point, spot or sun light dict as the Blender light the add-on would export it from
+    (addon/penumbra/io/lights.py, normalize on): power 4π·I, radius and soft falloff (off for
+    a sphere), spot cone and blend, sun strength E and angle; Blender's lights emit along −Z."""
+    import bpy
+    import mathutils
+
+    if "point" in l:
+        kind = "SPOT" if "spot" in l else "POINT"
+        S = 4.0 * math.pi * np.asarray(l["intensity"], dtype=np.float64)
+        emit = np.asarray(l["spot"]["direction"], dtype=np.float64) if "spot" in l else np.array([0, 0, -1.0])
+        at = np.asarray(l["point"], dtype=np.float64)
+    else:
+        kind = "SUN"
+        S = np.asarray(l["irradiance"], dtype=np.float64)
+        emit = np.asarray(l["direction"], dtype=np.float64)
+        at = np.zeros(3)
+    data = bpy.data.lights.new(l["name"], kind)
+    data.energy = float(S.max())
+    data.color = tuple(S / S.max()) if S.max() > 0 else (1, 1, 1)
+    if kind == "SUN":
+        data.angle = float(l.get("angle", 0.0))
+    else:
+        data.shadow_soft_size = float(l.get("radius", 0.0))
+        data.use_soft_falloff = not l.get("sphere", False)
+    if kind == "SPOT":
+        data.spot_size = float(l["spot"]["angle"])
+        data.spot_blend = float(l["spot"].get("blend", 0.0))
+    ob = bpy.data.objects.new(l["name"], data)
+    z = -emit / np.linalg.norm(emit)
+    x = np.cross([0.0, 1.0, 0.0] if abs(z[1]) < 0.9 else [1.0, 0.0, 0.0], z)
+    x /= np.linalg.norm(x)
+    m = np.eye(4)
+    m[:3, 0], m[:3, 1], m[:3, 2], m[:3, 3] = x, np.cross(z, x), z, at
+    ob.matrix_world = mathutils.Matrix(m.tolist())
+    bpy.context.scene.collection.objects.link(ob)
+    return ob
 
 
 def baked_scene(bake: dict):

@@ -80,6 +80,14 @@ def bench_scene(name, exe, py, work, cfg):
     os.makedirs(wd, exist_ok=True)
     sp = os.path.join(wd, "scene.json")
     subprocess.run([exe, "scene", name, "-o", sp], check=True)
+    with open(sp) as f:
+        plain = json.load(f)
+    if any("polygon" not in l for l in plain["lights"]) or any(
+            m.get("output", True) is False for m in plain["meshes"]):
+        # The lightmap jobs build polygon lights and bake every mesh: no row for scenes with
+        # point, spot or sun lights or with scenery.
+        log(f"lightmap {name}: skipped (point/spot/sun lights or scenery)")
+        return None
     uvp = os.path.join(wd, "scene-uv.json")
     log(f"lightmap {name}: Lightmap Pack at {res_px}×{res_px}")
     _job(py, ["uv", sp, uvp, "--resolution", res_px], "uv")

@@ -373,6 +373,7 @@ def main():
         command += " --lightmap-only" + (f" --scenes {' '.join(a.scenes)}" if a.scenes != cfg.scenes
                                          else "")
         rows = [lightmap.bench_scene(n, a.exe, sys.executable, a.work, cfg) for n in a.scenes]
+        rows = [r for r in rows if r is not None]
         write_lightmaps(rows, machine(), command, a.out)
         return
     if a.uniform_only:
@@ -386,7 +387,9 @@ def main():
     res["lightmaps"] = []
     for name in a.scenes:
         bench_scene(name, a.exe, sys.executable, a.work, cfg, res["scenes"])
-        res["lightmaps"].append(lightmap.bench_scene(name, a.exe, sys.executable, a.work, cfg))
+        row = lightmap.bench_scene(name, a.exe, sys.executable, a.work, cfg)
+        if row is not None:
+            res["lightmaps"].append(row)
     res["cycles_uniform"] = [uniform_cycles.bench_scene(n, a.exe, sys.executable, a.work, cfg)
                              for n in a.scenes]
     res["scaling"] = [] if a.no_scaling else scaling(a.exe, a.work, cfg)
@@ -404,7 +407,9 @@ def main():
 
 def write_lightmaps(rows, mach, command, out):
     """The lightmap rows: OUT/lightmaps.json, and their section in OUT/results.md and (for
-    the repository's own bench/) README.md."""
+    the repository's own bench/) README.md. None when no scene has a lightmap row."""
+    if not rows:
+        return
     with open(os.path.join(out, "lightmaps.json"), "w") as f:
         json.dump(dict(machine=mach, command=command, scenes=rows), f, indent=1, default=float)
     text = lightmap.section(rows, mach, command)

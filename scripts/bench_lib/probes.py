@@ -78,6 +78,9 @@ def scene_probes(scene: dict, spacing: float):
             I.append(inside)
             off += len(v)
         verts, polys, inside = np.concatenate(V), np.concatenate(P), np.concatenate(I)
+        if m.get("output", True) is False:
+            # Scenery: Cycles sees it, nothing of it is scored (Penumbra outputs none).
+            inside = np.zeros_like(inside)
         meshes.append(dict(name=m["name"], verts=verts, tris=np.concatenate(T),
                            polygon=polys, probe=inside))
         pm.append(np.full(inside.sum(), mi))

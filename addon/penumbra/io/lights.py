@@ -40,15 +40,16 @@ Shapes and orientation
     mirrored (negative-determinant) matrices.
 
 Approximations (documented, not errors)
-    * POINT/SPOT ``shadow_soft_size`` (radius) r > 0: exported as a point of the same
-      intensity. With ``use_soft_falloff`` off Cycles uses a sphere light, whose irradiance on an
-      unoccluded receiver that sees the whole sphere is exactly I·cos/d² (tested); with soft
-      falloff (the default) Cycles uses a disk of radius r facing the receiver
-      (kernel/light/point.h), which gives exactly I·cos/(d² + r²) (tested): exported with
-      the scene JSON's ``radius``, which the core applies the same way. Shadows are hard (a
-      point) either way. Spots with a radius are exported the same way (untested).
-    * SUN ``angle``: exported as an exact direction. Unoccluded receivers get exactly E⊥·cos
-      while the sun disk is entirely above their horizon; shadows are hard.
+    * POINT/SPOT ``shadow_soft_size`` (radius) r > 0: exported with the scene JSON's
+      ``radius``, a round light with soft shadows. With soft falloff (the default) Cycles
+      uses a disk of radius r facing the receiver (kernel/light/point.h), which gives
+      exactly I·cos/(d² + r²) unoccluded (tested); with ``use_soft_falloff`` off a sphere
+      (``"sphere": true``), whose irradiance on a receiver that sees the whole sphere is
+      exactly I·cos/d² (tested). The core clips the disc facing each point against the
+      occluders (a 48-gon). A spot's cone is applied from the light's centre.
+    * SUN ``angle``: exported as the scene JSON's ``angle``, a disc of that angular diameter
+      with soft shadows. Unoccluded receivers get exactly E⊥·cos while the sun disk is
+      entirely above their horizon.
     * ``diffuse_factor`` (and the other influence factors) are EEVEE-only: Cycles ignores them
       (Blender's UI shows them for EEVEE only; the test proves Cycles ignores it), so do we.
     * ``cycles.max_bounces`` of a light only limits indirect light; ignored.
@@ -197,9 +198,12 @@ def lights_to_scene(obj, depsgraph=None, *, disk_segments: int = DEFAULT_DISK_SE
         else:
             I = S * r * r if r > 0.0 else S / math.pi
         d = {"name": name, "point": co.tolist(), "intensity": I.tolist()}
-        if r > 0.0 and getattr(light, "use_soft_falloff", True):
-            # Cycles' soft falloff: a disk of radius r facing the receiver, I·cos/(d² + r²).
+        if r > 0.0:
+            # Soft falloff: a disk of radius r facing the receiver, I·cos/(d² + r²); without
+            # it a sphere, I·cos/d². Both cast soft shadows.
             d["radius"] = r
+            if not getattr(light, "use_soft_falloff", True):
+                d["sphere"] = True
         if light.type == "SPOT":
             lens = np.array([np.linalg.norm(X), np.linalg.norm(Y), lz])
             if np.ptp(lens) > _SCALE_TOL * lens.max():
@@ -211,7 +215,10 @@ def lights_to_scene(obj, depsgraph=None, *, disk_segments: int = DEFAULT_DISK_SE
     if light.type == "SUN":
         half = 0.5 * float(light.angle)
         E = S if (getattr(light, "normalize", True) or half <= 0.0) else S * math.pi * math.sin(half) ** 2
-        return [{"name": name, "direction": emit.tolist(), "irradiance": E.tolist()}]
+        d = {"name": name, "direction": emit.tolist(), "irradiance": E.tolist()}
+        if half > 0.0:
+            d["angle"] = 2.0 * half
+        return [d]
     raise UnsupportedLightError(name, "type", f"unknown light type {light.type!r}")
 
 

@@ -292,6 +292,59 @@ pub fn room(clutter: usize) -> SceneJson {
     )
 }
 
+/// Round lights in an unbaked room (issue 14): a floor, a table and a block (the outputs) in
+/// an open-topped room whose walls only cast shadows and reflect (`output: false`), lit by a
+/// point light of radius 0.2, a spot of radius 0.1 with a blend, and a sun of angle 5°
+/// through the open top.
+pub fn mixed() -> SceneJson {
+    let room = cuboid([-2., -2., 0.], [2., 2., 2.6], true);
+    let mut walls = mesh("Room", room[2..].to_vec(), [0.75, 0.75, 0.72]);
+    walls.output = Some(false);
+    let mut table = cuboid([-0.6, -0.4, 0.7], [0.6, 0.4, 0.75], false);
+    for (x, y) in [(-0.55, -0.35), (0.55, -0.35), (0.55, 0.35), (-0.55, 0.35)] {
+        table.extend(cuboid(
+            [x - 0.03, y - 0.03, 0.0],
+            [x + 0.03, y + 0.03, 0.7],
+            false,
+        ));
+    }
+    let point = |name: &str, c: P, power: f64, radius: f64| LightJson {
+        name: name.into(),
+        point: Some(c),
+        // Blender's convention: intensity = power / 4π.
+        intensity: Some([power / (4.0 * PI); 3]),
+        radius: Some(radius),
+        ..Default::default()
+    };
+    let mut spot = point("Spot", [1.2, 0.9, 2.3], 150.0, 0.1);
+    spot.spot = Some(crate::scene::json::SpotJson {
+        direction: [-1.2, -0.9, -1.6],
+        angle: 50f64.to_radians(),
+        blend: 0.2,
+    });
+    let sun = LightJson {
+        name: "Sun".into(),
+        direction: Some([0.35, 0.25, -1.0]),
+        irradiance: Some([2.0, 1.9, 1.7]),
+        angle: Some(5f64.to_radians()),
+        ..Default::default()
+    };
+    wrap(
+        vec![
+            walls,
+            mesh("Floor", vec![room[0].clone()], [0.6, 0.6, 0.6]),
+            mesh("Table", table, [0.55, 0.35, 0.2]),
+            mesh(
+                "Block",
+                cuboid([0.8, -1.3, 0.0], [1.3, -0.8, 0.6], false),
+                [0.5, 0.5, 0.55],
+            ),
+        ],
+        vec![point("Bulb", [-0.9, 0.7, 1.8], 80.0, 0.2), spot, sun],
+        SettingsJson::default(),
+    )
+}
+
 /// Looks a built-in scene up by name: one of `NAMES`, or `data2-SEGxRINGS` (a finer
 /// sphere) or `room-N` (N clutter boxes of 12 triangles each on the table).
 pub fn by_name(name: &str) -> Option<SceneJson> {
@@ -310,16 +363,18 @@ pub fn by_name(name: &str) -> Option<SceneJson> {
         "chair" => chair(),
         "cornell" => cornell(),
         "room" => room(0),
+        "mixed" => mixed(),
         _ => return None,
     })
 }
 
-pub const NAMES: [&str; 7] = [
+pub const NAMES: [&str; 8] = [
     "data1",
     "data2",
     "chair",
     "cornell",
     "room",
+    "mixed",
     "data2-SEGxRINGS",
     "room-N",
 ];

@@ -5,6 +5,7 @@
 //! penumbra contains one of those triangles as candidates.
 
 pub mod exact;
+pub mod round;
 pub mod world;
 
 use glam::DVec3;
@@ -138,9 +139,12 @@ fn vertex_direct(
         }
         // A solid hides exactly what its outline seen from p hides: one convex polygon (or,
         // failing that, its faces turned towards p).
+        // A round light lights p through its disc facing p (`scene::disc`); the sun's is put
+        // beyond everything in the scene.
+        let disc = crate::scene::disc::facing(&light.kind, p, 2.0 * scene.diagonal());
         let light_plane = match &light.kind {
             LightKind::Area { plane, .. } => Some(*plane),
-            _ => None,
+            _ => disc.as_ref().map(|d| d.plane()),
         };
         let mut owned: Vec<Vec<DVec3>> = Vec::new();
         let mut face_refs: Vec<u32> = Vec::new();
@@ -175,6 +179,15 @@ fn vertex_direct(
             .map(|&f| scene.faces[f as usize].verts.as_slice())
             .chain(owned.iter().map(|v| v.as_slice()))
             .collect();
+        let simple_polys: Vec<&[DVec3]> = face_refs
+            .iter()
+            .map(|&f| {
+                simple[f as usize]
+                    .as_deref()
+                    .unwrap_or(scene.faces[f as usize].verts.as_slice())
+            })
+            .chain(owned.iter().map(|v| v.as_slice()))
+            .collect();
         e += match &light.kind {
             LightKind::Area {
                 verts,
@@ -187,15 +200,7 @@ fn vertex_direct(
                 plane,
                 *radiance,
                 relation,
-                &face_refs
-                    .iter()
-                    .map(|&f| {
-                        simple[f as usize]
-                            .as_deref()
-                            .unwrap_or(scene.faces[f as usize].verts.as_slice())
-                    })
-                    .chain(owned.iter().map(|v| v.as_slice()))
-                    .collect::<Vec<_>>(),
+                &simple_polys,
                 scene.settings.penumbra_visibility,
                 scene.settings.penumbra_samples,
             ),
@@ -203,24 +208,60 @@ fn vertex_direct(
                 position,
                 intensity,
                 spot,
-                radius,
-            } => {
-                let d2 = (*position - p).length_squared();
-                let soft = if *radius > 0.0 {
-                    d2 / (d2 + radius * radius)
-                } else {
-                    1.0
-                };
-                exact::point_light(p, n, *position, *intensity, spot.as_ref(), relation, &polys)
-                    * soft
-            }
+                ..
+            } => match &disc {
+                Some(d) => match spot {
+                    Some(s) => round::round_spot(
+                        p,
+                        n,
+                        &light.kind,
+                        d,
+                        s,
+                        *position,
+                        relation,
+                        &simple_polys,
+                        scene.settings.penumbra_visibility,
+                        scene.settings.penumbra_samples,
+                    ),
+                    None => round_light(p, n, &light.kind, d, relation, &simple_polys, scene),
+                },
+                None => {
+                    exact::point_light(p, n, *position, *intensity, spot.as_ref(), relation, &polys)
+                }
+            },
             LightKind::Sun {
                 direction,
                 irradiance,
-            } => exact::sun_light(p, n, *direction, *irradiance, relation, &polys),
+                ..
+            } => match &disc {
+                Some(d) => round_light(p, n, &light.kind, d, relation, &simple_polys, scene),
+                None => exact::sun_light(p, n, *direction, *irradiance, relation, &polys),
+            },
         };
     }
     (e, counts)
+}
+
+/// [`round::round_light`] with the scene's penumbra settings.
+fn round_light(
+    p: DVec3,
+    n: DVec3,
+    kind: &LightKind,
+    disc: &crate::scene::disc::Disc,
+    relation: Relation,
+    blockers: &[&[DVec3]],
+    scene: &Scene,
+) -> DVec3 {
+    round::round_light(
+        p,
+        n,
+        kind,
+        disc,
+        relation,
+        blockers,
+        scene.settings.penumbra_visibility,
+        scene.settings.penumbra_samples,
+    )
 }
 
 /// The outline of a convex solid seen from `p`, as a convex polygon in a plane parallel to

@@ -58,12 +58,15 @@ impl Sizing {
                             radius,
                         });
                     }
-                    LightKind::Point { position, .. } => {
-                        if face.plane.dist(*position) > 0.0 {
+                    LightKind::Point {
+                        position, radius, ..
+                    } => {
+                        // A round light is a ball of its radius (`scene::disc`).
+                        if face.plane.dist(*position) > -radius {
                             sources.push(Source {
                                 light: i,
                                 centre: *position,
-                                radius: 0.0,
+                                radius: *radius,
                             });
                         }
                     }

@@ -62,13 +62,22 @@ pub struct LightJson {
     pub intensity: Option<[f64; 3]>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spot: Option<SpotJson>,
-    /// Point/spot only: radius of Blender's soft falloff (irradiance I·cos/(d² + r²)).
+    /// Point/spot only: radius of a round light. Blender's soft falloff (the default): a disc
+    /// facing the receiver, irradiance I·cos/(d² + r²) unoccluded; soft shadows.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub radius: Option<f64>,
+    /// Point/spot with `radius` only: `true` makes the light a sphere (Blender's soft falloff
+    /// off), irradiance I·cos/d² unoccluded. Default `false`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sphere: Option<bool>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub direction: Option<[f64; 3]>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub irradiance: Option<[f64; 3]>,
+    /// Sun only: angular diameter of the sun's disc in radians, in [0, π) (Blender's `angle`);
+    /// soft shadows when above 0. Default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angle: Option<f64>,
 }
 
 /// A spot cone as Blender has it: the light points along `direction`; `angle` is the full

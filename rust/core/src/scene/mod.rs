@@ -2,6 +2,7 @@
 //! occluders alike) that remember their source polygon; lights become `Light`s.
 
 pub mod convex;
+pub mod disc;
 pub mod emitters;
 pub mod json;
 pub mod machine;
@@ -84,13 +85,20 @@ pub enum LightKind {
         position: DVec3,
         intensity: DVec3,
         spot: Option<Spot>,
-        /// Blender's soft falloff for a light of this radius: intensity · cos / (d² + r²)
-        /// (Cycles treats such a point as a disk facing the receiver). Shadows stay hard.
+        /// Radius of a round light (`disc`): with `sphere` off, Blender's soft falloff, a disc
+        /// of this radius facing the receiver (intensity · cos / (d² + r²) unoccluded); with
+        /// `sphere` on, a sphere. Its shadows have penumbrae. 0: a point, hard shadows.
         radius: f64,
+        sphere: bool,
     },
     /// A directional light: `direction` is where the light travels (unit), `irradiance` on a
-    /// surface facing it (W/m²).
-    Sun { direction: DVec3, irradiance: DVec3 },
+    /// surface facing it (W/m²); `half_angle` > 0 makes it a disc of that angular radius
+    /// (Blender's `angle` / 2), with penumbrae (`disc`).
+    Sun {
+        direction: DVec3,
+        irradiance: DVec3,
+        half_angle: f64,
+    },
 }
 
 #[derive(Debug, Clone, PartialEq)]

@@ -74,9 +74,12 @@ pub fn validate(s: &SceneJson) -> Result<Scene, BakeError> {
                 hi = hi.max(*v);
             }
         }
-        if let LightKind::Point { position, .. } = &light.kind {
-            lo = lo.min(*position);
-            hi = hi.max(*position);
+        if let LightKind::Point {
+            position, radius, ..
+        } = &light.kind
+        {
+            lo = lo.min(*position - DVec3::splat(*radius));
+            hi = hi.max(*position + DVec3::splat(*radius));
         }
         lights.push(light);
     }
@@ -390,11 +393,27 @@ fn validate_light(li: usize, l: &LightJson, obj: &str) -> Result<Light, BakeErro
                 format!("{radius} must be a finite length ≥ 0"),
             ));
         }
+        let sphere = l.sphere.unwrap_or(false);
+        if sphere && radius == 0.0 {
+            return Err(BakeError::invalid(
+                obj,
+                "sphere",
+                "a sphere needs a `radius` above 0",
+            ));
+        }
+        if l.angle.is_some() {
+            return Err(BakeError::invalid(
+                obj,
+                "angle",
+                "only a sun has an `angle` (a spot's cone is `spot.angle`)",
+            ));
+        }
         LightKind::Point {
             position,
             intensity,
             spot,
             radius,
+            sphere,
         }
     } else {
         let d = check_point(obj, "direction", l.direction.unwrap())?;
@@ -409,9 +428,30 @@ fn validate_light(li: usize, l: &LightJson, obj: &str) -> Result<Light, BakeErro
             })?,
             MAX_RADIANCE,
         )?;
+        let angle = l.angle.unwrap_or(0.0);
+        if !(angle.is_finite() && (0.0..std::f64::consts::PI).contains(&angle)) {
+            return Err(BakeError::invalid(
+                obj,
+                "angle",
+                format!("{angle} must be in [0, π) radians"),
+            ));
+        }
+        for (field, given) in [
+            ("radius", l.radius.is_some()),
+            ("sphere", l.sphere.is_some()),
+        ] {
+            if given {
+                return Err(BakeError::invalid(
+                    obj,
+                    field,
+                    "a sun has no radius (its size is `angle`)",
+                ));
+            }
+        }
         LightKind::Sun {
             direction: d.normalize(),
             irradiance,
+            half_angle: 0.5 * angle,
         }
     };
     Ok(Light {

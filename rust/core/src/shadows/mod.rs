@@ -8,6 +8,8 @@ pub mod critical_lines;
 pub mod culling;
 pub mod plane_cuts;
 pub mod polygons;
+pub mod round;
+pub mod spot_cone;
 pub mod umbra_pruning;
 pub mod volume;
 
@@ -40,8 +42,14 @@ fn light_in_front(kind: &LightKind, r: &Face, eps: f64) -> Option<Option<Vec<DVe
                 Some(Some(clipped))
             }
         }
-        LightKind::Point { position, .. } => (r.plane.dist(*position) > eps).then_some(None),
-        LightKind::Sun { direction, .. } => (r.plane.n.dot(*direction) < 0.0).then_some(None),
+        LightKind::Point {
+            position, radius, ..
+        } => (r.plane.dist(*position) > eps - radius).then_some(None),
+        LightKind::Sun {
+            direction,
+            half_angle,
+            ..
+        } => (r.plane.n.dot(*direction) < half_angle.sin()).then_some(None),
     }
 }
 
@@ -130,6 +138,8 @@ pub fn shadow_polygons(
         progress.check()?;
         progress.set_fraction(li as f64 / scene.lights.len() as f64);
         let t0 = std::time::Instant::now();
+        let verts: Vec<Vec<DVec3>> = outlines.iter().map(|o| o.0.clone()).collect();
+        let proxies = round::Proxies::new(scene, &light.kind, &verts);
         let volumes: Vec<Vec<ShadowVolumes>> = occs
             .par_iter()
             .enumerate()
@@ -137,7 +147,24 @@ pub fn shadow_polygons(
                 if buried.occluders[oi] || progress.is_cancelled() {
                     return Vec::new();
                 }
-                occluder_volumes(&light.kind, None, oi as u32, o, faces, eps)
+                match proxies.as_ref().map(|p| p.get(oi as u32)) {
+                    Some(round::Stand::Disc(k)) => {
+                        occluder_volumes(k, None, oi as u32, o, faces, eps)
+                    }
+                    Some(round::Stand::Cube(ks)) => ks
+                        .iter()
+                        .flat_map(|k| occluder_volumes(k, None, oi as u32, o, faces, eps))
+                        .map(|v| ShadowVolumes { umbra: None, ..v })
+                        .collect(),
+                    // Too near a round light for a proxy: its penumbra may be anywhere.
+                    Some(round::Stand::Everywhere) => vec![ShadowVolumes {
+                        occluder: oi as u32,
+                        penumbra: vec![Volume::default()],
+                        umbra: None,
+                        hard: false,
+                    }],
+                    None => occluder_volumes(&light.kind, None, oi as u32, o, faces, eps),
+                }
             })
             .collect();
         stats.shadow_pairs += volumes.iter().filter(|v| !v.is_empty()).count() as u64;
@@ -168,7 +195,12 @@ pub fn shadow_polygons(
             .enumerate()
             .map(|(oi, rs)| {
                 let own = |f: u32| scene.face_occluder[f as usize] as usize == oi;
-                screen_faces(&light_points, &outlines[oi].0, rs, faces, own, eps)
+                let light_points = match proxies.as_ref().map(|p| p.get(oi as u32)) {
+                    Some(round::Stand::Disc(LightKind::Area { verts, .. })) => verts.as_slice(),
+                    Some(_) => &[],
+                    None => light_points.as_slice(),
+                };
+                screen_faces(light_points, &outlines[oi].0, rs, faces, own, eps)
             })
             .collect();
         for (oi, rs) in found.iter().enumerate() {
@@ -200,6 +232,7 @@ pub fn shadow_polygons(
                     &volumes,
                     &hits[ri],
                     tol,
+                    proxies.as_ref(),
                 )
             })
             .collect();
@@ -275,6 +308,7 @@ fn receiver_polygons(
     volumes: &[Vec<ShadowVolumes>],
     hits: &[u32],
     tol: &Tolerances,
+    proxies: Option<&round::Proxies>,
 ) -> OnReceiver {
     let eps = tol.eps;
     let Some(clipped_light) = light_in_front(kind, r, eps) else {
@@ -355,6 +389,15 @@ fn receiver_polygons(
             continue;
         }
         let recomputed;
+        // A round light's proxy disc (`round`), cut to this receiver's front like an area
+        // light: the part behind holds no ray from the receiver to the round light.
+        let (kind, clipped_light) = match proxies.map(|p| p.get(oi)) {
+            Some(round::Stand::Disc(pk)) => match light_in_front(pk, r, eps) {
+                None => continue,
+                Some(c) => (pk, c),
+            },
+            _ => (kind, clipped_light.clone()),
+        };
         let svs: &[ShadowVolumes] = match &clipped_light {
             None => &volumes[oi as usize],
             Some(lv) => {
@@ -372,7 +415,9 @@ fn receiver_polygons(
         for sv in svs {
             for p in &sv.penumbra {
                 if let Some(poly) = clip_to_volume(r, p, eps) {
-                    if let (LightKind::Area { verts, plane, .. }, false) = (kind, sv.hard) {
+                    if let (LightKind::Area { verts, plane, .. }, false, None) =
+                        (kind, sv.hard, proxies)
+                    {
                         let lv = clipped_light.as_deref().unwrap_or(verts);
                         let occ = &scene.occluders[oi as usize];
                         critical_segments(lv, plane, occ, &scene.faces, r, &poly, tol, &mut events);
@@ -399,6 +444,16 @@ fn receiver_polygons(
                 }
             }
         }
+    }
+    if let LightKind::Point {
+        position,
+        spot: Some(spot),
+        radius,
+        ..
+    } = kind
+    {
+        let band = scene.settings.penumbra_element_size;
+        spot_cone::cone_edges(*position, spot, *radius, r, band, &mut events);
     }
     OnReceiver {
         exposure: Exposure::Regions,

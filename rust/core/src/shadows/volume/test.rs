@@ -94,6 +94,7 @@ fn point_light_volume_is_hard() {
         intensity: DVec3::ONE,
         spot: None,
         radius: 0.0,
+        sphere: false,
     };
     let occ = face(square(DVec3::new(0., 0., 1.), 0.5, true));
     let sv = shadow_volumes(&kind, None, 0, &occ, 1e-12).unwrap();
