@@ -85,7 +85,9 @@ fn cancel_returns_within_a_second_in_every_stage() {
 
 /// The direct stage cancelled part of the way through: at its start (before any vertex),
 /// and with a quarter, half and three quarters of the vertices done. Once took 1.7 s at
-/// load 9 when the cancel came at the stage's start.
+/// load 9: after the last vertex was skipped, the bake freed its regions and meshes before
+/// returning, 0.2-0.3 s in a debug build (now freed aside as soon as the elements are
+/// assembled: 4-63 ms from cancel to return in a debug build).
 #[test]
 fn cancel_returns_within_a_second_anywhere_in_the_direct_stage() {
     let scene = busy_scene();

@@ -67,3 +67,92 @@ pub fn refine_in_rounds(
         }
     }
 }
+
+#[cfg(test)]
+mod test {
+    use super::*;
+
+    /// Random points and crossing constraints in the unit square, seeded.
+    fn triangulation() -> Cdt {
+        let mut seed = 15u64;
+        let mut next = move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut cdt = Cdt::new();
+        for _ in 0..400 {
+            let _ = cdt.insert(Point2::new(next(), next()));
+        }
+        for _ in 0..60 {
+            let a = cdt.insert(Point2::new(next(), next())).unwrap();
+            let b = cdt.insert(Point2::new(next(), next())).unwrap();
+            if a != b {
+                cdt.add_constraint_and_split(a, b, |p| p);
+            }
+        }
+        cdt
+    }
+
+    fn params() -> RefinementParameters<f64> {
+        RefinementParameters::new()
+            .with_angle_limit(spade::AngleLimit::from_deg(25.0))
+            .with_max_allowed_area(2e-5)
+            .with_min_required_area(1e-8)
+    }
+
+    fn snapshot(cdt: &Cdt) -> (Vec<[f64; 2]>, Vec<[usize; 3]>) {
+        (
+            cdt.vertices()
+                .map(|v| [v.position().x, v.position().y])
+                .collect(),
+            cdt.inner_faces()
+                .map(|f| f.vertices().map(|v| v.fix().index()))
+                .collect(),
+        )
+    }
+
+    /// A refinement larger than one inline call (42k vertices) gives exactly the mesh of a
+    /// single spade call (the 20k-vertex rounds it replaces restarted spade each round).
+    #[test]
+    fn a_large_refinement_is_the_single_call_mesh() {
+        let mut once = triangulation();
+        let allowance = 1_000_000;
+        once.refine(params().with_max_additional_vertices(allowance));
+        assert!(
+            once.num_vertices() > 2 * INLINE_VERTICES,
+            "{}",
+            once.num_vertices()
+        );
+        let mut ours = triangulation();
+        refine_in_rounds(&mut ours, params(), allowance, &Progress::new()).unwrap();
+        assert_eq!(snapshot(&ours), snapshot(&once));
+    }
+
+    #[test]
+    fn a_cancel_returns_while_spade_refines() {
+        let p = std::sync::Arc::new(Progress::new());
+        let q = p.clone();
+        let canceller = std::thread::spawn(move || {
+            std::thread::sleep(Duration::from_millis(5));
+            q.cancel();
+            std::time::Instant::now()
+        });
+        let mut cdt = triangulation();
+        // Small enough triangles that spade would add millions of vertices.
+        let r = refine_in_rounds(
+            &mut cdt,
+            params()
+                .with_max_allowed_area(1e-9)
+                .with_min_required_area(0.0),
+            10_000_000,
+            &p,
+        );
+        let returned = std::time::Instant::now();
+        let cancelled = canceller.join().unwrap();
+        assert_eq!(r, Err(BakeError::Cancelled));
+        let took = returned.saturating_duration_since(cancelled);
+        assert!(took < Duration::from_millis(200), "{took:?}");
+    }
+}
