@@ -209,13 +209,25 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
         })
         .collect::<Result<_, _>>()?;
     let elements = assemble(scene, &meshes);
+    // The regions and per-receiver meshes are done with. Freeing them (a million small
+    // allocations on a floor under a thousand shadows; 0.2 s in a debug build) happens on a
+    // thread of its own, so that neither a cancel in a later stage nor the end of the bake
+    // waits for it.
+    std::thread::spawn(move || drop((regions, meshes)));
     stats.T_m = t.elapsed().as_secs_f64();
     stats.N_e = elements.triangles.len() as u64;
     stats.N_v = elements.positions.len() as u64;
 
     progress.stage("direct light");
     let t = Instant::now();
-    let (direct, pairs) = direct::direct_irradiance(scene, &tol, &elements, progress)?;
+    let (direct, pairs) = match direct::direct_irradiance(scene, &tol, &elements, progress) {
+        Ok(d) => d,
+        Err(e) => {
+            // Cancelled: return now and free the elements aside (see above).
+            std::thread::spawn(move || drop(elements));
+            return Err(e);
+        }
+    };
     stats.T_direct = t.elapsed().as_secs_f64();
     [stats.pairs_umbra, stats.pairs_lit, stats.pairs_penumbra] = pairs;
 

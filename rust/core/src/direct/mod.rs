@@ -39,6 +39,7 @@ pub fn direct_irradiance(
         .par_iter()
         .map(|f| crate::geom::simplify::simplified(&f.verts))
         .collect();
+    progress.check()?;
     let done = std::sync::atomic::AtomicUsize::new(0);
     let results: Vec<(DVec3, [u64; 3])> = (0..nv)
         .into_par_iter()
@@ -46,6 +47,9 @@ pub fn direct_irradiance(
             let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             if k % 4096 == 0 {
                 progress.set_fraction(k as f64 / nv as f64);
+                // The memory watchdog looks only in `check`; a cancel it makes is seen
+                // below, at every vertex.
+                let _ = progress.check();
             }
             if progress.is_cancelled() {
                 return (DVec3::ZERO, [0; 3]);

@@ -55,13 +55,14 @@ pub fn mesh_receiver(
     progress: &crate::Progress,
 ) -> Result<ReceiverMesh, BakeError> {
     let arr = &rr.arrangement;
+    let shift = shift_away_from_zero(&arr.vertices);
     let mut cdt = Cdt::new();
     let mut handle: HashMap<u32, FixedVertexHandle> = HashMap::new();
     let mut vh = |cdt: &mut Cdt, v: u32| -> Option<FixedVertexHandle> {
         if let Some(h) = handle.get(&v) {
             return Some(*h);
         }
-        let p = arr.vertices[v as usize];
+        let p = arr.vertices[v as usize] + shift;
         let h = cdt.insert(Point2::new(p.x, p.y)).ok()?;
         handle.insert(v, h);
         Some(h)
@@ -109,10 +110,12 @@ pub fn mesh_receiver(
             ),
         ));
     }
+    let dense = handle.len() > DENSE_RATIO * seeds.len().max(1);
     for (k, p) in seeds.into_iter().enumerate() {
         if k % 4096 == 0 {
             progress.check()?;
         }
+        let p = p + shift;
         let _ = cdt.insert(Point2::new(p.x, p.y));
     }
     progress.check()?;
@@ -129,7 +132,7 @@ pub fn mesh_receiver(
         RefinementParameters::new()
             .with_angle_limit(AngleLimit::from_deg(settings.min_angle))
             .with_max_allowed_area(coarse_area * 1.5)
-            .with_min_required_area(fine_area * 0.02),
+            .with_min_required_area(fine_area * if dense { DENSE_MIN_AREA } else { 0.02 }),
         extra,
         progress,
     )?;
@@ -138,7 +141,7 @@ pub fn mesh_receiver(
         Ordering::Relaxed,
     );
     if settings.uniform {
-        let mut m = extract(&cdt, rr, sizing.frame(), true, tol);
+        let mut m = extract(&cdt, shift, rr, sizing.frame(), true, tol);
         m.regions = vec![rr.faces.first().cloned().unwrap_or(Region {
             relations: Vec::new(),
             blockers: Vec::new(),
@@ -146,7 +149,58 @@ pub fn mesh_receiver(
         return Ok(m);
     }
     progress.check()?;
-    Ok(extract(&cdt, rr, sizing.frame(), false, tol))
+    Ok(extract(&cdt, shift, rr, sizing.frame(), false, tol))
+}
+
+/// A receiver is dense when its discontinuity vertices outnumber the lattice its element
+/// sizes ask for by this much: the discontinuities alone then cut it finer than the finest
+/// element (quads2000's floor: 211k arrangement vertices against some thousand lattice
+/// points, under 2,000 overlapping penumbrae).
+const DENSE_RATIO: usize = 16;
+/// On a dense receiver, refinement for angles stops at triangles below this fraction of
+/// the finest element's area (side about half the finest element) instead of 0.02 of it.
+/// Such triangles lie between discontinuity edges, where the light is smooth, and a
+/// linear element's value error there is bounded by its longest edge, not by its angles;
+/// further splitting only multiplied vertices (quads2000: 622k vertices, 409k with this,
+/// each one a visible-light computation under ~6 occluders).
+const DENSE_MIN_AREA: f64 = 0.3;
+
+/// Where the triangulation holds the receiver: its 2-D frame, moved so that every coordinate
+/// lies between one and two times the receiver's span when some coordinate is a rounding
+/// residue (nonzero, within 1e-12 of the span of zero). The frame's origin is one of the
+/// receiver's vertices, so points on the edges through it have coordinates near zero, where
+/// the rounding residue of a clipped point (1e-17 off a line through the origin) is itself a
+/// representable coordinate: the triangulation then sees a boundary that zigzags at that scale,
+/// and Delaunay refinement splits it without end, each split an encroachment of the next
+/// (quads2000's floor: 450k of its 1.05M vertices, on the two sides through the origin). At
+/// coordinates of one magnitude such residues round away, and a straight boundary stays
+/// straight. The shift moves points by at most an ulp of the span, far below the
+/// arrangement's snapping distance.
+fn shift_away_from_zero(verts: &[DVec2]) -> DVec2 {
+    let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+    for p in verts {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    if !(lo.x <= hi.x && lo.y <= hi.y) {
+        return DVec2::ZERO;
+    }
+    let span = (hi - lo).max_element();
+    // Only a frame with such residues is moved: moving rounds every coordinate by up to an
+    // ulp of the span, which changes the triangulation of any receiver a little, for no
+    // gain where no coordinate sits within rounding of zero.
+    let residue = 1e-12 * span;
+    let near_zero = |c: f64| c != 0.0 && c.abs() <= residue;
+    if !verts.iter().any(|p| near_zero(p.x) || near_zero(p.y)) {
+        return DVec2::ZERO;
+    }
+    // A power of two: the coordinates then share one binade, [span, 2·span), and one ulp.
+    let span = if span > 0.0 {
+        2f64.powi(span.log2().ceil() as i32)
+    } else {
+        1.0
+    };
+    DVec2::new(span - lo.x, span - lo.y)
 }
 
 /// Ends of D0 lines (the feet of a box on the floor, where a solid passes through): there
@@ -320,6 +374,7 @@ fn winding(verts: &[DVec2], l: &[u32], p: DVec2) -> i32 {
 /// once each), and the D0 vertex split.
 fn extract(
     cdt: &Cdt,
+    shift: DVec2,
     rr: &ReceiverRegions,
     frame: &Frame,
     uniform: bool,
@@ -328,7 +383,7 @@ fn extract(
     let nv = cdt.num_vertices();
     let mut positions: Vec<DVec2> = cdt
         .vertices()
-        .map(|v| DVec2::new(v.position().x, v.position().y))
+        .map(|v| DVec2::new(v.position().x, v.position().y) - shift)
         .collect();
     let faces: Vec<_> = cdt.inner_faces().collect();
     let face_index: HashMap<_, usize> = faces
@@ -382,7 +437,7 @@ fn extract(
             }
         }
         let c = faces[best.1].center();
-        regions.push(rr.classify(DVec2::new(c.x, c.y)));
+        regions.push(rr.classify(DVec2::new(c.x, c.y) - shift));
     }
 
     // D0 split: group the triangles around each vertex into sectors that do not cross a
@@ -428,7 +483,7 @@ fn extract(
             return true;
         }
         let (p, q) = (e.from().position(), e.to().position());
-        on_contact(DVec2::new(p.x, p.y), DVec2::new(q.x, q.y))
+        on_contact(DVec2::new(p.x, p.y) - shift, DVec2::new(q.x, q.y) - shift)
     };
     let mut d0_vertices = Vec::new();
     for e in cdt.undirected_edges() {

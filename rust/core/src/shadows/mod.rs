@@ -108,6 +108,35 @@ fn occluder_outline(occ: &Occluder, faces: &[Face]) -> (Vec<DVec3>, Vec<[DVec3; 
     }
 }
 
+/// The faces with many-edged ones replaced by their simplified outlines (`geom::simplify`),
+/// or `None` when no face has one.
+fn simplified_occluders(faces: &[Face]) -> Option<Vec<Face>> {
+    let simple: Vec<Option<Vec<DVec3>>> = faces
+        .par_iter()
+        .map(|f| crate::geom::simplify::simplified(&f.verts))
+        .collect();
+    if simple.iter().all(Option::is_none) {
+        return None;
+    }
+    Some(
+        faces
+            .iter()
+            .zip(simple)
+            .map(|(f, s)| match s {
+                Some(verts) => {
+                    let poly2 = verts.iter().map(|v| f.frame.to_2d(*v)).collect();
+                    Face {
+                        verts,
+                        poly2,
+                        ..f.clone()
+                    }
+                }
+                None => f.clone(),
+            })
+            .collect(),
+    )
+}
+
 /// Shadow polygons on every receiver for every light.
 pub fn shadow_polygons(
     scene: &Scene,
@@ -121,6 +150,7 @@ pub fn shadow_polygons(
     let outlines: Vec<(Vec<DVec3>, Vec<[DVec3; 2]>)> =
         occs.iter().map(|o| occluder_outline(o, faces)).collect();
     let buried = crate::shadows::buried::burial(scene, eps);
+    let simple_faces = simplified_occluders(faces);
     let mut stats = EdgeStats::default();
     let mut per_receiver: Vec<ReceiverShadows> = (0..faces.len())
         .map(|i| ReceiverShadows {
@@ -138,6 +168,14 @@ pub fn shadow_polygons(
         progress.check()?;
         progress.set_fraction(li as f64 / scene.lights.len() as f64);
         let t0 = std::time::Instant::now();
+        // Under an area light a many-edged occluder casts its simplified outline's shadow
+        // (`geom::simplify`): the same outline the direct stage subtracts from the light, so
+        // the mesh follows the field that is computed. A hard shadow stays exact: there the
+        // outline is the D0 edge itself.
+        let occ_faces: &[Face] = match (&light.kind, &simple_faces) {
+            (LightKind::Area { .. }, Some(f)) => f,
+            _ => faces,
+        };
         let verts: Vec<Vec<DVec3>> = outlines.iter().map(|o| o.0.clone()).collect();
         let proxies = round::Proxies::new(scene, &light.kind, &verts);
         let volumes: Vec<Vec<ShadowVolumes>> = occs
@@ -163,7 +201,7 @@ pub fn shadow_polygons(
                         umbra: None,
                         hard: false,
                     }],
-                    None => occluder_volumes(&light.kind, None, oi as u32, o, faces, eps),
+                    None => occluder_volumes(&light.kind, None, oi as u32, o, occ_faces, eps),
                 }
             })
             .collect();
@@ -228,6 +266,7 @@ pub fn shadow_polygons(
                     &light.kind,
                     r,
                     scene,
+                    occ_faces,
                     &outlines,
                     &volumes,
                     &hits[ri],
@@ -304,6 +343,7 @@ fn receiver_polygons(
     kind: &LightKind,
     r: &Face,
     scene: &Scene,
+    occ_faces: &[Face],
     outlines: &[(Vec<DVec3>, Vec<[DVec3; 2]>)],
     volumes: &[Vec<ShadowVolumes>],
     hits: &[u32],
@@ -406,7 +446,7 @@ fn receiver_polygons(
                     Some(lv),
                     oi,
                     &scene.occluders[oi as usize],
-                    &scene.faces,
+                    occ_faces,
                     eps,
                 );
                 &recomputed
@@ -420,7 +460,7 @@ fn receiver_polygons(
                     {
                         let lv = clipped_light.as_deref().unwrap_or(verts);
                         let occ = &scene.occluders[oi as usize];
-                        critical_segments(lv, plane, occ, &scene.faces, r, &poly, tol, &mut events);
+                        critical_segments(lv, plane, occ, occ_faces, r, &poly, tol, &mut events);
                     }
                     // Point/sun: the one volume is umbra and penumbra at once.
                     out.push(ShadowPolygon {
