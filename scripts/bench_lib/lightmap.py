@@ -177,17 +177,16 @@ def section(results, machine, command):
     return "\n".join(L) + "\n"
 
 
-def splice(path, text):
-    """Puts `text` between the lightmap markers of the file at `path` (appended the first
-    time)."""
+def splice(path, text, start=START, end=END):
+    """Puts `text` between the markers `start` and `end` of the file at `path` (appended the
+    first time): the bench's generated sections (lightmaps, Cycles on a uniform mesh)."""
     with open(path) as f:
         body = f.read()
-    block = f"{START}\n{text}{END}"
-    if START in body and END in body:
-        head, rest = body.split(START, 1)
-        body = head + block + rest.split(END, 1)[1]
+    block = f"{start}\n{text}{end}"
+    if start in body and end in body:
+        head, rest = body.split(start, 1)
+        body = head + block + rest.split(end, 1)[1]
     else:
         body = body.rstrip("\n") + "\n\n" + block + "\n"
     with open(path, "w") as f:
         f.write(body)
-

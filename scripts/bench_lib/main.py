@@ -406,34 +406,30 @@ def main():
 
 
 def write_lightmaps(rows, mach, command, out):
-    """The lightmap rows: OUT/lightmaps.json, and their section in OUT/results.md and (for
-    the repository's own bench/) README.md. None when no scene has a lightmap row."""
-    if not rows:
-        return
-    with open(os.path.join(out, "lightmaps.json"), "w") as f:
-        json.dump(dict(machine=mach, command=command, scenes=rows), f, indent=1, default=float)
-    text = lightmap.section(rows, mach, command)
-    md = os.path.join(out, "results.md")
-    if not os.path.exists(md):
-        open(md, "w").close()
-    lightmap.splice(md, text)
-    if os.path.abspath(out) == os.path.join(ROOT, "bench"):
-        lightmap.splice(os.path.join(ROOT, "README.md"), text)
-    print(text)
+    """The lightmap rows: OUT/lightmaps.json and their section. Nothing when no scene has a
+    lightmap row."""
+    if rows:
+        write_section("lightmaps", rows, lightmap.section(rows, mach, command), mach, command,
+                      out, lightmap.START, lightmap.END)
 
 
 def write_uniform(rows, mach, command, out):
-    """Cycles on a uniform mesh: OUT/cycles_uniform.json, and its section in OUT/results.md
-    and (for the repository's own bench/) README.md."""
-    with open(os.path.join(out, "cycles_uniform.json"), "w") as f:
+    """Cycles on a uniform mesh: OUT/cycles_uniform.json and its section."""
+    write_section("cycles_uniform", rows, uniform_cycles.section(rows, mach, command), mach,
+                  command, out, uniform_cycles.START, uniform_cycles.END)
+
+
+def write_section(name, rows, text, mach, command, out, start, end):
+    """OUT/NAME.json, and `text` between `start` and `end` in OUT/results.md and (for the
+    repository's own bench/) README.md."""
+    with open(os.path.join(out, f"{name}.json"), "w") as f:
         json.dump(dict(machine=mach, command=command, scenes=rows), f, indent=1, default=float)
-    text = uniform_cycles.section(rows, mach, command)
     md = os.path.join(out, "results.md")
     if not os.path.exists(md):
         open(md, "w").close()
-    uniform_cycles.splice(md, text)
+    lightmap.splice(md, text, start, end)
     if os.path.abspath(out) == os.path.join(ROOT, "bench"):
-        uniform_cycles.splice(os.path.join(ROOT, "README.md"), text)
+        lightmap.splice(os.path.join(ROOT, "README.md"), text, start, end)
     print(text)
 
 

@@ -144,18 +144,3 @@ def section(results, machine, command):
             L.append(f"| {r['scene']} | {c['method']} | {c['vertices']} | {c['wall']:.2f} | "
                      f"{c['rel_rms']:.4f} |")
     return "\n".join(L) + "\n"
-
-
-def splice(path, text):
-    """Puts `text` between this section's markers of the file at `path` (appended the first
-    time)."""
-    with open(path) as f:
-        body = f.read()
-    block = f"{START}\n{text}{END}"
-    if START in body and END in body:
-        head, rest = body.split(START, 1)
-        body = head + block + rest.split(END, 1)[1]
-    else:
-        body = body.rstrip("\n") + "\n\n" + block + "\n"
-    with open(path, "w") as f:
-        f.write(body)
