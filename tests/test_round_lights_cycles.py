@@ -27,18 +27,8 @@ BLOCK = ((-0.37, -0.29, 0.0), (0.21, 0.33, 0.7))
 
 
 def _floor():
-    t = np.linspace(-SIDE / 2, SIDE / 2, GRID)
-    xs, ys = np.meshgrid(t, t, indexing="xy")
-    verts = np.stack([xs.ravel(), ys.ravel(), np.zeros(GRID * GRID)], axis=1)
-    faces = [(j * GRID + i, j * GRID + i + 1, (j + 1) * GRID + i + 1, (j + 1) * GRID + i)
-             for j in range(GRID - 1) for i in range(GRID - 1)]
-    me = bpy.data.meshes.new("Floor")
-    me.from_pydata(verts.tolist(), [], faces)
-    me.update()
-    me.materials.append(cr.diffuse_material("FloorMat", (0.6, 0.6, 0.6)))
-    ob = bpy.data.objects.new("Floor", me)
-    bpy.context.scene.collection.objects.link(ob)
-    return ob
+    return cr.add_grid(GRID, SIDE, material=cr.diffuse_material("FloorMat", (0.6, 0.6, 0.6)),
+                       name="Floor")
 
 
 LIGHTS = {

@@ -12,6 +12,7 @@ use penumbra::regions::relation::Relation;
 use penumbra::scene::disc::facing;
 use penumbra::scene::json::{LightJson, SettingsJson};
 use penumbra::scene::settings::PenumbraVisibility;
+use penumbra::scene::LightKind;
 use std::f64::consts::PI;
 
 fn settings() -> SettingsJson {
@@ -26,6 +27,23 @@ fn settings() -> SettingsJson {
 
 /// Floor 6 × 6 at z = 0 and a box [−0.5, 0.5]² × [0, 1] (on the floor, not touching it
 /// exactly: lifted 0.2 so the shadow has both a penumbra and an umbra all round).
+/// The exact irradiance (red) a round light gives the floor point `p` in relation `rel`,
+/// with `blockers` hiding part of the disc facing it.
+fn floor_light(kind: &LightKind, p: DVec3, rel: Relation, blockers: &[&[DVec3]]) -> f64 {
+    let disc = facing(kind, p, 100.0).unwrap();
+    round_light(
+        p,
+        DVec3::Z,
+        kind,
+        &disc,
+        rel,
+        blockers,
+        PenumbraVisibility::Exact,
+        0,
+    )
+    .x
+}
+
 fn check(light: LightJson) -> (f64, usize) {
     let box_polys = cuboid([-0.5, -0.5, 0.2], [0.5, 0.5, 1.0]);
     let s = scene(
@@ -48,20 +66,7 @@ fn check(light: LightJson) -> (f64, usize) {
     let (mut worst, mut peak, mut partial) = (0.0f64, 0.0f64, 0);
     for (v, c) in floor.positions.iter().zip(&floor.colors) {
         let p = DVec3::from_array(*v);
-        let disc = facing(kind, p, 100.0).unwrap();
-        let e = |rel, b: &[&[DVec3]]| {
-            round_light(
-                p,
-                DVec3::Z,
-                kind,
-                &disc,
-                rel,
-                b,
-                PenumbraVisibility::Exact,
-                0,
-            )
-            .x
-        };
+        let e = |rel, b: &[&[DVec3]]| floor_light(kind, p, rel, b);
         let want = e(Relation::Penumbra, &blockers) / PI;
         let all = e(Relation::Lit, &[]) / PI;
         if want > 0.02 * all && want < 0.98 * all {
@@ -150,20 +155,7 @@ fn soft_point_light_in_a_room() {
     let (mut worst, mut peak) = (0.0f64, 0.0f64);
     for (v, c) in b.meshes[0].positions.iter().zip(&b.meshes[0].colors) {
         let p = DVec3::from_array(*v);
-        let disc = facing(kind, p, 100.0).unwrap();
-        let e = |rel, b: &[&[DVec3]]| {
-            round_light(
-                p,
-                DVec3::Z,
-                kind,
-                &disc,
-                rel,
-                b,
-                PenumbraVisibility::Exact,
-                0,
-            )
-            .x
-        };
+        let e = |rel, b: &[&[DVec3]]| floor_light(kind, p, rel, b);
         peak = peak.max(e(Relation::Lit, &[]) / PI);
         worst = worst.max((c[0] - e(Relation::Penumbra, &blockers) / PI).abs());
     }

@@ -115,11 +115,11 @@ fn the_penumbra_grows_with_the_radius() {
     }
 }
 
-#[test]
-fn a_round_spot_blurs_its_cone_edge_over_the_disc() {
-    use crate::scene::Spot;
+/// A hard 30° cone from (0, 0, 2) straight down, from a disc of radius 0.1: its apex, cone
+/// and light.
+fn hard_spot_30() -> (DVec3, crate::scene::Spot, LightKind) {
     let apex = DVec3::new(0.0, 0.0, 2.0);
-    let spot = Spot {
+    let spot = crate::scene::Spot {
         direction: -DVec3::Z,
         cos_half_angle: 30f64.to_radians().cos(),
         blend: 0.0,
@@ -131,6 +131,12 @@ fn a_round_spot_blurs_its_cone_edge_over_the_disc() {
         radius: 0.1,
         sphere: false,
     };
+    (apex, spot, kind)
+}
+
+#[test]
+fn a_round_spot_blurs_its_cone_edge_over_the_disc() {
+    let (apex, spot, kind) = hard_spot_30();
     let at = |x: f64| {
         let p = DVec3::new(x, 0.0, 0.0);
         let disc = facing(&kind, p, 20.0).unwrap();
@@ -155,24 +161,11 @@ fn a_round_spot_blurs_its_cone_edge_over_the_disc() {
 
 #[test]
 fn a_shadow_edge_across_a_round_spot_s_cone_edge() {
-    use crate::scene::Spot;
     // Hard cone of 30° from (0, 0, 2) straight down; from the point on its edge the disc's
     // outer half (x > 0) is inside the cone (its directions to p are steeper), and a half-plane
     // at height 1 through the line of sight hides exactly that half: almost nothing is left,
     // where the product of the two halves would give a quarter.
-    let apex = DVec3::new(0.0, 0.0, 2.0);
-    let spot = Spot {
-        direction: -DVec3::Z,
-        cos_half_angle: 30f64.to_radians().cos(),
-        blend: 0.0,
-    };
-    let kind = LightKind::Point {
-        position: apex,
-        intensity: DVec3::ONE,
-        spot: None,
-        radius: 0.1,
-        sphere: false,
-    };
+    let (apex, spot, kind) = hard_spot_30();
     let edge = 2.0 * 30f64.to_radians().tan();
     let p = DVec3::new(edge, 0.0, 0.0);
     let occ: Vec<DVec3> = [
