@@ -187,3 +187,60 @@ impl Shooter<'_> {
             .collect()
     }
 }
+
+#[cfg(test)]
+mod test {
+    use super::*;
+    use crate::scene::json::{LightJson, SceneJson, SettingsJson};
+    use crate::scenes::{cuboid, polygons_mesh};
+
+    fn quad(z: f64, h: f64, up: bool) -> Vec<[f64; 3]> {
+        let mut v = vec![[-h, -h, z], [h, -h, z], [h, h, z], [-h, h, z]];
+        if !up {
+            v.reverse();
+        }
+        v
+    }
+
+    fn scene(meshes: Vec<crate::scene::json::MeshJson>) -> Scene {
+        crate::scene::validate(&SceneJson {
+            format: "penumbra-scene".into(),
+            version: 1,
+            meshes,
+            lights: vec![LightJson {
+                name: "Bulb".into(),
+                point: Some([0.3, 0.2, 0.5]),
+                intensity: Some([1.0; 3]),
+                ..Default::default()
+            }],
+            settings: SettingsJson::default(),
+        })
+        .unwrap()
+    }
+
+    #[test]
+    fn only_thin_faces_with_something_behind_are_two_sided() {
+        // A floor with nothing under it; a plane facing up over it (the floor is behind
+        // it, facing it); a box above that (a solid); a black plane facing down, whose
+        // back sees the box but reflects nothing.
+        let sc = scene(vec![
+            polygons_mesh("Floor", vec![quad(0.0, 2.0, true)], None),
+            polygons_mesh("Plane", vec![quad(1.0, 1.0, true)], None),
+            polygons_mesh(
+                "Box",
+                cuboid([-0.5, -0.5, 1.5], [0.5, 0.5, 2.0], false),
+                None,
+            ),
+            polygons_mesh("Black", vec![quad(1.2, 0.2, false)], Some([0.0; 3])),
+        ]);
+        let emission = vec![DVec3::ZERO; sc.faces.len()];
+        assert_eq!(two_sided(&sc, &emission, 1e-9), vec![1]);
+        // Turned down with nothing above, the plane's back has nowhere to send light.
+        let sc = scene(vec![
+            polygons_mesh("Floor", vec![quad(0.0, 2.0, true)], None),
+            polygons_mesh("Plane", vec![quad(1.0, 1.0, false)], None),
+        ]);
+        let emission = vec![DVec3::ZERO; sc.faces.len()];
+        assert!(two_sided(&sc, &emission, 1e-9).is_empty());
+    }
+}
