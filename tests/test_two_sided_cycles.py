@@ -5,7 +5,8 @@ facing up: it lights only the ceiling's back, never the floor. Cycles' diffuse s
 reflect from both sides, so all the floor's light is what the ceiling's back reflects down
 (and what goes round between them). Cycles bakes a face's front only, so the ceiling's own
 bake is black in both. The same scene with a closed slab in place of the plane: the light
-falls on the slab's underside, a front, and its inside stays dark.
+falls on the slab's underside, a front, and its inside stays dark. And plates over the floor
+lit from above: their backs get only the floor's light, and send part of it back.
 
 Compared at the floor grid's interior vertices (vertices of Penumbra's output too), with
 Cycles' noise from two seeds taken out.
@@ -55,7 +56,23 @@ def _slab(seed):
     return floor
 
 
-@pytest.mark.parametrize("build", [_plane, _slab], ids=["plane", "slab"])
+def _plates(seed):
+    """Nine single plates facing up at different heights over the floor, lit from above:
+    their backs get no direct light, only what the floor reflects, and send it back down."""
+    cr.new_bounce_scene(SAMPLES, seed)
+    floor = cr.add_grid(GRID, SIDE, material=cr.diffuse_material("FloorMat", (0.6, 0.6, 0.6)),
+                        name="Floor")
+    mat = cr.diffuse_material("PlateMat", (0.8, 0.75, 0.7))
+    for k in range(9):
+        x, y = -0.8 + 0.8 * (k % 3), -0.8 + 0.8 * (k // 3)
+        cr.add_grid(2, 0.5, location=(x, y, 0.5 + 0.1 * ((k * 5) % 4)), material=mat,
+                    name=f"Plate{k}")
+    cr.add_light("AREA", location=(0.2, 0.1, 2.5), name="Lamp", energy=300.0, size=1.0)
+    bpy.context.view_layer.update()
+    return floor
+
+
+@pytest.mark.parametrize("build", [_plane, _slab, _plates], ids=["plane", "slab", "plates"])
 def test_light_behind_a_thin_ceiling_reaches_the_floor_like_cycles(build):
     refs = [cr.bake_vertex_colors(build(seed)) for seed in (1, 2)]
     (pos, a), (_, b) = refs

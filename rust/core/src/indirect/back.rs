@@ -14,13 +14,15 @@
 //! (`patches::Grid`), whole: the cover rule (`coplanar_contacts`) is about a face lying
 //! against the front, and leaves the back open. A back patch's radiosity is its albedo
 //! times the mean irradiance at its stratified points: direct light there
-//! (`direct::back`), and what the shots send to about four of them (`back_gains`).
+//! (`direct::back`), and what the shots send to about four of them, or its centroid when
+//! it is small seen from the shooter (`back_gains`).
 
 use glam::DVec3;
 use rayon::prelude::*;
 
 use super::patches::{patch, Grid, Patch};
 use super::shooter::{Group, Shooter};
+use super::FEW_RAYS_BELOW;
 use crate::geom::bvh::{Aabb, BoxTree};
 use crate::geom::polygon::{signed_area_2d, simplify_convex};
 use crate::geom::raycast::Occluders;
@@ -162,7 +164,11 @@ impl Shooter<'_> {
                 let mut out = Vec::new();
                 let Some(pair) = pair else { return out };
                 for q in start..end {
-                    let points = &self.patches[q as usize].samples[1];
+                    // A back patch small as seen from the shooter takes the factor at its
+                    // centroid, as a far shooter gets one ray (`ONE_RAY_BELOW`).
+                    let back = &self.patches[q as usize];
+                    let size = back.radius / (back.centroid - patch.centroid).length();
+                    let points = &back.samples[if size < FEW_RAYS_BELOW { 0 } else { 1 }];
                     let (lo, hi) = points.iter().fold((points[0], points[0]), |(lo, hi), x| {
                         (lo.min(*x), hi.max(*x))
                     });
