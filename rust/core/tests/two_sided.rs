@@ -95,3 +95,27 @@ fn closed_box_reflects_from_its_outside_only() {
     eprintln!("box from below: floor mean {mean:.5}, worst error {worst:.4} of it");
     assert!(worst < 0.02, "{worst}");
 }
+
+/// A box standing on the plane covers the plane's front under it (`coplanar_contacts`),
+/// not its back: the floor under the plane gets the same light with or without the box.
+#[test]
+fn a_box_on_the_plane_covers_its_front_not_its_back() {
+    let plane = || {
+        let mut p = mesh("Plane", vec![quad([0., 0., 1.], PLANE, PLANE, true)]);
+        p.albedo = Some(penumbra::scene::json::PerPolygon::Uniform([RHO; 3]));
+        p
+    };
+    let without = bake(&scene(vec![floor(), plane()], vec![sun()], settings(0.2)));
+    let stand = mesh("Box", cuboid([0.0, -0.6, 1.0], [0.8, 0.6, 1.5]));
+    let with = bake(&scene(
+        vec![floor(), plane(), stand],
+        vec![sun()],
+        settings(0.2),
+    ));
+    let (a, b) = (&without.meshes[0], &with.meshes[0]);
+    assert_eq!(a.positions, b.positions);
+    let top = a.colors.iter().map(|c| c[0]).fold(0.0, f64::max);
+    for (x, y) in a.colors.iter().zip(&b.colors) {
+        assert!((x[0] - y[0]).abs() <= 1e-3 * top, "{x:?} {y:?}");
+    }
+}
