@@ -9,6 +9,8 @@ fn one_and_four_threads_agree_bit_for_bit() {
     meshes.push(mesh("Box", cuboid([-0.3, -0.2, 0.0], [0.3, 0.4, 0.5])));
     meshes.push(mesh("Ball", uv_sphere([0.8, 0.6, 0.9], 0.3, 12, 8)));
     meshes.push(mesh("Panel", vec![quad([-0.7, 0.5, 1.1], 0.3, 0.2, false)]));
+    // Facing up over the bulb: lit on its back, which shoots down (indirect/back.rs).
+    meshes.push(mesh("Shade", vec![quad([-1.0, -1.0, 1.7], 0.4, 0.4, true)]));
     let lights = vec![
         area_light("Key", quad([0.5, 0.3, 2.0], 0.3, 0.2, false)),
         point_light("Bulb", [-1.0, -1.0, 1.5]),

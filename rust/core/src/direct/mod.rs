@@ -4,6 +4,7 @@
 //! integral; otherwise the exact visible part of the light, with only the occluders whose
 //! penumbra contains one of those triangles as candidates.
 
+pub(crate) mod back;
 pub mod exact;
 pub mod round;
 pub mod world;
@@ -192,58 +193,90 @@ fn vertex_direct(
             })
             .chain(owned.iter().map(|v| v.as_slice()))
             .collect();
-        e += match &light.kind {
-            LightKind::Area {
-                verts,
-                plane,
-                radiance,
-            } => exact::area_light(
-                on_light_plane(scene, el, v, p, plane, tol),
-                n,
-                verts,
-                plane,
-                *radiance,
-                relation,
-                &simple_polys,
-                scene.settings.penumbra_visibility,
-                scene.settings.penumbra_samples,
-            ),
-            LightKind::Point {
-                position,
-                intensity,
-                spot,
-                ..
-            } => match &disc {
-                Some(d) => match spot {
-                    Some(s) => round::round_spot(
-                        p,
-                        n,
-                        &light.kind,
-                        d,
-                        s,
-                        *position,
-                        relation,
-                        &simple_polys,
-                        scene.settings.penumbra_visibility,
-                        scene.settings.penumbra_samples,
-                    ),
-                    None => round_light(p, n, &light.kind, d, relation, &simple_polys, scene),
-                },
-                None => {
-                    exact::point_light(p, n, *position, *intensity, spot.as_ref(), relation, &polys)
-                }
-            },
-            LightKind::Sun {
-                direction,
-                irradiance,
-                ..
-            } => match &disc {
-                Some(d) => round_light(p, n, &light.kind, d, relation, &simple_polys, scene),
-                None => exact::sun_light(p, n, *direction, *irradiance, relation, &polys),
-            },
+        let area_at = match &light.kind {
+            LightKind::Area { plane, .. } => on_light_plane(scene, el, v, p, plane, tol),
+            _ => p,
         };
+        e += light_irradiance(
+            scene,
+            light,
+            p,
+            area_at,
+            n,
+            relation,
+            &polys,
+            &simple_polys,
+            disc.as_ref(),
+        );
     }
     (e, counts)
+}
+
+/// One light's irradiance at `p` (unit normal `n`) for `relation`: `polys` are the convex
+/// occluders that may hide it (`simple_polys` the same with many-edged outlines simplified,
+/// for the area-light booleans), `disc` a round light's disc facing `p`, and `area_at` where
+/// an area light is evaluated (`on_light_plane`). Shared with the backs of thin faces
+/// (`back`), which have no relations.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn light_irradiance(
+    scene: &Scene,
+    light: &crate::scene::Light,
+    p: DVec3,
+    area_at: DVec3,
+    n: DVec3,
+    relation: Relation,
+    polys: &[&[DVec3]],
+    simple_polys: &[&[DVec3]],
+    disc: Option<&crate::scene::disc::Disc>,
+) -> DVec3 {
+    match &light.kind {
+        LightKind::Area {
+            verts,
+            plane,
+            radiance,
+        } => exact::area_light(
+            area_at,
+            n,
+            verts,
+            plane,
+            *radiance,
+            relation,
+            simple_polys,
+            scene.settings.penumbra_visibility,
+            scene.settings.penumbra_samples,
+        ),
+        LightKind::Point {
+            position,
+            intensity,
+            spot,
+            ..
+        } => match disc {
+            Some(d) => match spot {
+                Some(s) => round::round_spot(
+                    p,
+                    n,
+                    &light.kind,
+                    d,
+                    s,
+                    *position,
+                    relation,
+                    simple_polys,
+                    scene.settings.penumbra_visibility,
+                    scene.settings.penumbra_samples,
+                ),
+                None => round_light(p, n, &light.kind, d, relation, simple_polys, scene),
+            },
+            None => exact::point_light(p, n, *position, *intensity, spot.as_ref(), relation, polys),
+        },
+        LightKind::Sun {
+            direction,
+            irradiance,
+            ..
+        } => match disc {
+            Some(d) => round_light(p, n, &light.kind, d, relation, simple_polys, scene),
+            None => exact::sun_light(p, n, *direction, *irradiance, relation, polys),
+        },
+    }
 }
 
 /// [`round::round_light`] with the scene's penumbra settings.

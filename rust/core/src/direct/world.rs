@@ -31,8 +31,7 @@ pub fn world_irradiance(
     visibility_rays: u32,
     progress: &Progress,
 ) -> Result<Vec<DVec3>, BakeError> {
-    let n = (visibility_rays.saturating_mul(RAYS_PER_SETTING)).clamp(1, MAX_RAYS);
-    let dirs = cosine_directions(n);
+    let dirs = directions(visibility_rays);
     let nv = el.positions.len();
     let done = std::sync::atomic::AtomicUsize::new(0);
     let out: Vec<DVec3> = (0..nv)
@@ -46,16 +45,26 @@ pub fn world_irradiance(
                 return DVec3::ZERO;
             }
             let p = el.eval.get(v).copied().unwrap_or(el.positions[v]);
-            let (t, b, nrm) = basis(el.normals[v]);
-            let open = dirs
-                .iter()
-                .filter(|d| !occ.ray_blocked(p, t * d.x + b * d.y + nrm * d.z))
-                .count();
-            world * (PI * open as f64 / n as f64)
+            world_at(world, p, el.normals[v], &dirs, occ)
         })
         .collect();
     progress.check()?;
     Ok(out)
+}
+
+/// The directions `world_at` takes for the `visibility_rays` setting.
+pub(crate) fn directions(visibility_rays: u32) -> Vec<DVec3> {
+    cosine_directions((visibility_rays.saturating_mul(RAYS_PER_SETTING)).clamp(1, MAX_RAYS))
+}
+
+/// World irradiance at `p` (unit normal `n`): `dirs` (from `directions`) turned about `n`.
+pub(crate) fn world_at(world: DVec3, p: DVec3, n: DVec3, dirs: &[DVec3], occ: &Occluders) -> DVec3 {
+    let (t, b, nrm) = basis(n);
+    let open = dirs
+        .iter()
+        .filter(|d| !occ.ray_blocked(p, t * d.x + b * d.y + nrm * d.z))
+        .count();
+    world * (PI * open as f64 / dirs.len().max(1) as f64)
 }
 
 /// `n` unit directions about +Z, cosine-weighted: Hammersley points on the unit square

@@ -111,6 +111,39 @@ impl BoxTree {
             }
         }
     }
+
+    /// Whether `keep` holds for some item whose box may touch the convex volume given by
+    /// `planes` (as [`query_volume`](Self::query_volume)); stops at the first.
+    pub fn any_in_volume(
+        &self,
+        planes: &[Plane],
+        eps: f64,
+        mut keep: impl FnMut(u32) -> bool,
+    ) -> bool {
+        if self.nodes.is_empty() {
+            return false;
+        }
+        let mut stack = vec![0usize];
+        while let Some(i) = stack.pop() {
+            let n = &self.nodes[i];
+            if !n.bounds.may_touch(planes, eps) {
+                continue;
+            }
+            if n.count > 0 {
+                let items = &self.items[n.start as usize..(n.start + n.count) as usize];
+                if items
+                    .iter()
+                    .any(|&it| self.boxes[it as usize].may_touch(planes, eps) && keep(it))
+                {
+                    return true;
+                }
+            } else {
+                stack.push(n.start as usize);
+                stack.push(n.start as usize + 1);
+            }
+        }
+        false
+    }
 }
 
 fn build(

@@ -14,20 +14,28 @@ use crate::geom::polygon::clip_polygon_3d;
 use crate::geom::Plane;
 
 impl Shooter<'_> {
-    /// The receivers of shots from face `fp` that something could stand in front of.
-    pub(super) fn face_blockers(&self, fp: u32) -> Option<&[Reached]> {
-        let cell = self.face_blockers[fp as usize].get_or_init(|| {
+    /// The receivers of shots from face `fp` (from its back if `back`) that something could
+    /// stand in front of.
+    pub(super) fn face_blockers(&self, fp: u32, back: bool) -> Option<&[Reached]> {
+        let nf = self.scene.faces.len();
+        let cell = self.face_blockers[fp as usize + back as usize * nf].get_or_init(|| {
             if self.kept.load(Ordering::Relaxed) > FACE_OCCLUDER_BUDGET {
                 return None;
             }
             let face = &self.scene.faces[fp as usize];
+            let plane = if back {
+                face.plane.flipped()
+            } else {
+                face.plane
+            };
             let found: Vec<Reached> = self
                 .receivers
                 .par_iter()
                 .filter_map(|&f| {
-                    let (lo, hi) = self.shaft(&face.verts, fp, &face.plane, f)?;
+                    let front = self.scene.faces[f as usize].plane;
+                    let (lo, hi) = self.shaft(&face.verts, fp, &plane, f, &front)?;
                     let mut list = Vec::new();
-                    let planes = [face.plane, self.scene.faces[f as usize].plane];
+                    let planes = [plane, front];
                     self.occ.candidates(lo, hi, &planes, &[fp, f], &mut list);
                     match list.len() {
                         0 => None,
@@ -51,13 +59,15 @@ impl Shooter<'_> {
     }
 
     /// Whether a shooter polygon `poly` on face `fp` (plane `plane`) can light receiver face
-    /// `f`, and then the box around the part of it in front of `f` and `f`.
+    /// `f` on its side `side` (its plane, or turned round for its back), and then the box
+    /// around the part of it in front of `f` and `f`.
     pub(super) fn shaft(
         &self,
         poly: &[DVec3],
         fp: u32,
         plane: &Plane,
         f: u32,
+        side: &Plane,
     ) -> Option<(DVec3, DVec3)> {
         if f == fp {
             return None;
@@ -68,7 +78,7 @@ impl Shooter<'_> {
         if face.verts.iter().all(|v| plane.dist(*v) <= self.tol) {
             return None;
         }
-        if poly.iter().all(|v| face.plane.dist(*v) <= self.tol) {
+        if poly.iter().all(|v| side.dist(*v) <= self.tol) {
             return None;
         }
         let mut lo = DVec3::splat(f64::INFINITY);
@@ -90,9 +100,23 @@ impl Shooter<'_> {
         f: u32,
         known: Option<&'s [Reached]>,
     ) -> Option<Pair<'s>> {
-        self.shaft(poly, fp, plane, f)?;
-        let face = &self.scene.faces[f as usize];
-        let poly = clip_polygon_3d(poly, &face.plane, self.tol);
+        let side = self.scene.faces[f as usize].plane;
+        self.pair_on(poly, fp, plane, f, side, known)
+    }
+
+    /// `pair` for the side of face `f` whose plane is `side` (for its back, the face's plane
+    /// turned round; `known` then `None`, as lists are kept for fronts only).
+    pub(super) fn pair_on<'s>(
+        &self,
+        poly: &[DVec3],
+        fp: u32,
+        plane: &Plane,
+        f: u32,
+        side: Plane,
+        known: Option<&'s [Reached]>,
+    ) -> Option<Pair<'s>> {
+        self.shaft(poly, fp, plane, f, &side)?;
+        let poly = clip_polygon_3d(poly, &side, self.tol);
         if poly.len() < 3 {
             return None;
         }
@@ -110,6 +134,7 @@ impl Shooter<'_> {
         };
         Some(Pair {
             face: f,
+            plane: side,
             poly,
             lo,
             hi,
@@ -140,7 +165,7 @@ impl Shooter<'_> {
                     .filter(|&o| self.occ.box_overlaps(o, lo, hi)),
             ),
             None => {
-                let planes = [*plane, self.scene.faces[pair.face as usize].plane];
+                let planes = [*plane, pair.plane];
                 self.occ
                     .candidates(lo, hi, &planes, &[fp, pair.face], &mut list);
             }

@@ -24,6 +24,7 @@
 //! `receiver` (one vertex's factor), `fit` (far groups), `gather` and `mls` (which
 //! vertices, and the rest from them).
 
+mod back;
 mod blockers;
 pub(crate) mod coplanar_contacts;
 mod fit;
@@ -122,7 +123,7 @@ fn indirect_at(
     let cover_tol = 1e-6 * scene.diagonal();
     let covers = crate::indirect::coplanar_contacts::covers(&scene.faces, cover_tol);
     let open = crate::indirect::coplanar_contacts::open_parts_of(&scene.faces, &covers, cover_tol);
-    let patches = build_patches(
+    let mut patches = build_patches(
         &scene.faces,
         &open,
         el,
@@ -138,10 +139,28 @@ fn indirect_at(
             emission[f as usize] = DVec3::ZERO;
         }
     }
+    // The backs of thin faces (`back`) come after every front.
+    let fronts = patches.len();
+    let two_sided = back::two_sided(scene, &emission, occ.tolerance());
+    patches.extend(back::back_patches(
+        scene,
+        &two_sided,
+        el,
+        settings.patch_size,
+        settings.visibility_rays,
+    ));
+    progress.check()?;
+    let back_direct = back::back_direct(scene, occ, &patches[fronts..], progress)?;
     let mut unshot: Vec<DVec3> = patches
         .iter()
         .map(|p| albedo(p) * mean(&p.weights, direct) + PI * emission[p.face as usize])
         .collect();
+    for (u, (p, e)) in unshot[fronts..]
+        .iter_mut()
+        .zip(patches[fronts..].iter().zip(&back_direct))
+    {
+        *u += albedo(p) * *e;
+    }
     let power = |b: DVec3, p: &Patch| b.element_sum() * p.area;
     let emitted: f64 = unshot.iter().zip(&patches).map(|(b, p)| power(*b, p)).sum();
     let mut irradiance = vec![DVec3::ZERO; nv];

@@ -5,6 +5,8 @@
 
 use glam::DVec3;
 
+use crate::geom::Plane;
+
 /// A receiver face and what could stand between it and a shooter face.
 pub(super) type Reached = (u32, FaceBlockers);
 
@@ -13,10 +15,12 @@ pub(super) enum FaceBlockers {
     Many,
 }
 
-/// A receiver face in one shot: the shooter clipped to the face's front half-space, and
+/// A receiver face in one shot: the shooter clipped to the receiving side's half-space, and
 /// which faces could block the rays between them.
 pub(super) struct Pair<'s> {
     pub(super) face: u32,
+    /// The receiving side's plane: the face's, or turned round for its back.
+    pub(super) plane: Plane,
     pub(super) poly: Vec<DVec3>,
     /// Bounds of `poly`.
     pub(super) lo: DVec3,

@@ -10,6 +10,7 @@ use glam::{DVec2, DVec3};
 use crate::geom::polygon::{
     clip_polygon_2d, signed_area_2d, simplify_convex, strictly_inside_convex, HalfPlane,
 };
+use crate::geom::Plane;
 use crate::indirect::coplanar_contacts::Open;
 use crate::mesh::elements::Elements;
 use crate::progress::Progress;
@@ -20,8 +21,12 @@ use crate::BakeError;
 pub struct Patch {
     /// Receiver face (index into `Scene::faces`).
     pub face: u32,
-    /// Convex, counter-clockwise seen from the face's front.
+    /// Convex, counter-clockwise seen from the side it shoots from.
     pub poly: Vec<DVec3>,
+    /// The plane it shoots from: the face's, or for the back of a thin face (`back`) the
+    /// face's turned round.
+    pub plane: Plane,
+    pub back: bool,
     pub area: f64,
     pub centroid: DVec3,
     /// Largest distance from the centroid to a corner.
@@ -197,14 +202,14 @@ pub fn build_patches(
 
 /// The face's grid: `n` cells of size `cell` (at most `patch_size`, so that no sliver
 /// column or row is left over at the far edge) from the corner `origin` of its bounds.
-struct Grid {
+pub(super) struct Grid {
     origin: DVec2,
     cell: DVec2,
-    n: (u64, u64),
+    pub(super) n: (u64, u64),
 }
 
 impl Grid {
-    fn new(poly: &[DVec2], patch_size: f64) -> Self {
+    pub(super) fn new(poly: &[DVec2], patch_size: f64) -> Self {
         let mut lo = DVec2::splat(f64::INFINITY);
         let mut hi = DVec2::splat(f64::NEG_INFINITY);
         for p in poly {
@@ -239,7 +244,7 @@ impl Grid {
 
     /// The face polygon within the cell; outer cells are open outwards so that points
     /// rounded just past the bounds stay in.
-    fn clip(&self, poly: &[DVec2], (i, j): (u64, u64)) -> Vec<DVec2> {
+    pub(super) fn clip(&self, poly: &[DVec2], (i, j): (u64, u64)) -> Vec<DVec2> {
         let lo = self.origin + self.cell * DVec2::new(i as f64, j as f64);
         let hi = lo + self.cell;
         let mut out = poly.to_vec();
@@ -282,7 +287,7 @@ impl Grid {
     }
 }
 
-fn patch(
+pub(super) fn patch(
     face: u32,
     f: &Face,
     poly2: &[DVec2],
@@ -332,6 +337,8 @@ fn patch(
     Patch {
         face,
         poly,
+        plane: f.plane,
+        back: false,
         area,
         centroid,
         radius,

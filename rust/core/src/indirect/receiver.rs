@@ -29,8 +29,8 @@ impl Shooter<'_> {
             if b == DVec3::ZERO {
                 continue;
             }
-            let plane = self.scene.faces[patch.face as usize].plane;
-            let known = self.face_blockers(patch.face);
+            let plane = patch.plane;
+            let known = self.face_blockers(patch.face, patch.back);
             let Some(pair) = self.pair(&patch.poly, patch.face, &plane, f, known) else {
                 continue;
             };
@@ -51,11 +51,25 @@ impl Shooter<'_> {
         v: u32,
         b: DVec3,
     ) -> f64 {
-        let x = self.points[v as usize];
+        let (x, n) = (self.points[v as usize], self.el.normals[v as usize]);
+        self.receive_at(patch, plane, pair, blockers, x, n, b)
+    }
+
+    /// `receive` at any point `x` with unit normal `n` on the receiving side of `pair`.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn receive_at(
+        &self,
+        patch: &Patch,
+        plane: &Plane,
+        pair: &Pair,
+        blockers: &Blockers,
+        x: DVec3,
+        n: DVec3,
+        b: DVec3,
+    ) -> f64 {
         if plane.dist(x) <= self.tol {
             return 0.0;
         }
-        let n = self.el.normals[v as usize];
         let ff = form_factor(x, n, &pair.poly);
         if !(ff > 0.0) {
             return 0.0;

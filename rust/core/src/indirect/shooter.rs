@@ -42,7 +42,10 @@ pub(super) struct Shooter<'a> {
     /// Per shooter face, filled on its first shot: the receiver faces that something could
     /// stand in front of, ascending, with what (for the whole face: each patch narrows it
     /// down). `None` inside when over the memory budget: then each patch asks the BVH.
+    /// Fronts first, then backs (`face + faces`).
     pub(super) face_blockers: Vec<OnceLock<Option<Vec<Reached>>>>,
+    /// The backs of thin faces that receive.
+    pub(super) backs: super::back::Backs,
     pub(super) kept: AtomicUsize,
     /// Per patch, after its first shot: the faces it reached and each of their vertices'
     /// form factor times visibility. A patch shoots again whenever light came back to it
@@ -93,8 +96,9 @@ impl<'a> Shooter<'a> {
         for f in 0..nf {
             vert_start[f + 1] += vert_start[f];
         }
+        // Fronts only: the backs of thin faces come after them all (`back`).
         let mut patch_start = vec![0u32; nf + 1];
-        for p in patches {
+        for p in patches.iter().filter(|p| !p.back) {
             patch_start[p.face as usize + 1] += 1;
         }
         for f in 0..nf {
@@ -197,7 +201,8 @@ impl<'a> Shooter<'a> {
             points,
             negligible,
             tol,
-            face_blockers: (0..nf).map(|_| OnceLock::new()).collect(),
+            face_blockers: (0..2 * nf).map(|_| OnceLock::new()).collect(),
+            backs: super::back::Backs::new(patches),
             kept: AtomicUsize::new(0),
             factors: (0..patches.len()).map(|_| OnceLock::new()).collect(),
             factors_kept: AtomicUsize::new(0),
@@ -220,8 +225,8 @@ impl<'a> Shooter<'a> {
             return (Cow::Borrowed(known), None);
         }
         let patch = &self.patches[p];
-        let plane = self.scene.faces[patch.face as usize].plane;
-        let known = self.face_blockers(patch.face);
+        let plane = patch.plane;
+        let known = self.face_blockers(patch.face, patch.back);
         let pairs: Vec<Pair> = self
             .receivers
             .par_iter()
@@ -285,7 +290,7 @@ impl<'a> Shooter<'a> {
             .iter()
             .flat_map(|pair| self.patches_of(pair.face))
             .collect();
-        let to_patches: Vec<(u32, f64)> = touched
+        let mut to_patches: Vec<(u32, f64)> = touched
             .par_iter()
             .with_min_len(64)
             .map(|&q| (q as u32, mean(&self.patch_weights[q], &g_of)))
@@ -293,6 +298,8 @@ impl<'a> Shooter<'a> {
             .into_iter()
             .filter(|&(_, m)| m != 0.0)
             .collect();
+        // The backs of thin faces, after every front (`back`).
+        to_patches.extend(self.back_gains(patch, b));
         // Kept group by group, leaving out the groups that got nothing (behind the shooter,
         // or in shadow), which are often most of them.
         let mut known = Factors {

@@ -1,0 +1,252 @@
+//! The backs of thin surfaces. Cycles' diffuse surfaces reflect from both sides, so a single
+//! plane lit from behind (a ceiling panel over a lamp facing up, a leaf, a sheet) sends
+//! that light on into the half-space behind it. Cycles bakes only a face's front, and so
+//! do we (the elements are on the front); what the back changes is the light it reflects
+//! onto other surfaces, so the back is a shooter and a receiver of this stage only.
+//!
+//! A face is two-sided when it is thin: not part of a closed convex solid
+//! (`scene::solids`), the same rule as for emissive faces (`scene::emitters`). A solid's
+//! faces are one-sided: their backs face its inside, which nothing outside sees.
+//!
+//! Cost stays where light goes: a thin face gets back patches only when some other face
+//! lies behind it with its front (or, if thin, its back) turned towards it, so that light
+//! from the back has somewhere to land. The back patches are the face's grid cells
+//! (`patches::Grid`), whole: the cover rule (`coplanar_contacts`) is about a face lying
+//! against the front, and leaves the back open. A back patch's radiosity is its albedo
+//! times the mean irradiance at its stratified points: direct light there
+//! (`direct::back`), and what the shots send to about four of them, or its centroid when
+//! it is small seen from the shooter (`back_gains`).
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::patches::{patch, Grid, Patch};
+use super::shooter::{Group, Shooter};
+use super::FEW_RAYS_BELOW;
+use crate::geom::bvh::{Aabb, BoxTree};
+use crate::geom::polygon::{signed_area_2d, simplify_convex};
+use crate::geom::raycast::Occluders;
+use crate::mesh::elements::Elements;
+use crate::progress::Progress;
+use crate::scene::solids::Occluder;
+use crate::scene::Scene;
+use crate::BakeError;
+
+/// The faces with back patches, and where those are in the patch list.
+pub(super) struct Backs {
+    /// `(face, first patch, end)`, ascending.
+    faces: Vec<(u32, u32, u32)>,
+}
+
+impl Backs {
+    /// From the patch list (backs after all fronts, by face).
+    pub(super) fn new(patches: &[Patch]) -> Self {
+        let mut faces: Vec<(u32, u32, u32)> = Vec::new();
+        for (i, p) in patches.iter().enumerate().filter(|(_, p)| p.back) {
+            match faces.last_mut() {
+                Some(last) if last.0 == p.face => last.2 = i as u32 + 1,
+                _ => faces.push((p.face, i as u32, i as u32 + 1)),
+            }
+        }
+        Backs { faces }
+    }
+}
+
+/// Whether face `f` is thin (reflects from both sides).
+pub(crate) fn is_thin(scene: &Scene, f: u32) -> bool {
+    let o = scene.face_occluder[f as usize] as usize;
+    matches!(scene.occluders[o], Occluder::Face(_))
+}
+
+/// The thin faces whose backs can light another face, ascending: they reflect or emit
+/// (`emission`: what the indirect stage sends for each face), and some other face has a
+/// part more than `tol` behind them and its front turned their way (or, itself thin, its
+/// back).
+pub(super) fn two_sided(scene: &Scene, emission: &[DVec3], tol: f64) -> Vec<u32> {
+    let faces = &scene.faces;
+    let tree = BoxTree::new(faces.iter().map(|f| Aabb::from_points(&f.verts)).collect());
+    (0..faces.len() as u32)
+        .into_par_iter()
+        .filter(|&f| {
+            let face = &faces[f as usize];
+            let bright =
+                face.albedo.max_element() > 0.0 || emission[f as usize].max_element() > 0.0;
+            if !bright || !is_thin(scene, f) {
+                return false;
+            }
+            let back = face.plane.flipped();
+            // Boxes wholly within `tol` in front of the face are passed over.
+            tree.any_in_volume(&[back], -tol, |g| {
+                let other = &faces[g as usize];
+                g != f
+                    && other.verts.iter().any(|v| back.dist(*v) > tol)
+                    && face.verts.iter().any(|v| {
+                        let d = other.plane.dist(*v);
+                        d > tol || (d < -tol && is_thin(scene, g))
+                    })
+            })
+        })
+        .collect()
+}
+
+/// Back patches of `faces` (ascending): each face's grid cells, turned round.
+pub(super) fn back_patches(
+    scene: &Scene,
+    faces: &[u32],
+    el: &Elements,
+    patch_size: f64,
+    rays: u32,
+) -> Vec<Patch> {
+    faces
+        .par_iter()
+        .flat_map_iter(|&fi| {
+            let f = &scene.faces[fi as usize];
+            let grid = Grid::new(&f.poly2, patch_size);
+            let (nx, ny) = grid.n;
+            let mut out = Vec::new();
+            for j in 0..ny {
+                for i in 0..nx {
+                    let poly2 = simplify_convex(&grid.clip(&f.poly2, (i, j)));
+                    if poly2.len() < 3 || !(signed_area_2d(&poly2) > 0.0) {
+                        continue;
+                    }
+                    // Seeded apart from the front's cells.
+                    let seed = 1 << 63 ^ (fi as u64) << 40 ^ j << 20 ^ i;
+                    let mut p = patch(fi, f, &poly2, &[], el, rays, seed);
+                    p.poly.reverse();
+                    p.plane = f.plane.flipped();
+                    p.back = true;
+                    out.push(p);
+                }
+            }
+            out
+        })
+        .collect()
+}
+
+/// Each back patch's mean direct irradiance (lights and world) over its stratified points.
+pub(super) fn back_direct(
+    scene: &Scene,
+    occ: &Occluders,
+    backs: &[Patch],
+    progress: &Progress,
+) -> Result<Vec<DVec3>, BakeError> {
+    let (mut points, mut faces) = (Vec::new(), Vec::new());
+    for p in backs {
+        points.extend_from_slice(&p.samples[2]);
+        faces.extend(std::iter::repeat_n(p.face, p.samples[2].len()));
+    }
+    let e = crate::direct::back::back_irradiance(scene, occ, &points, &faces, progress)?;
+    let mut at = 0;
+    Ok(backs
+        .iter()
+        .map(|p| {
+            let n = p.samples[2].len();
+            let sum: DVec3 = e[at..at + n].iter().copied().sum();
+            at += n;
+            sum / n.max(1) as f64
+        })
+        .collect())
+}
+
+impl Shooter<'_> {
+    /// What each back patch gains per unit of radiosity shot by `patch`: the mean over its
+    /// points of form factor times visibility; `b` only decides how hard to look. Patches
+    /// that gain nothing are left out.
+    pub(super) fn back_gains(&self, patch: &Patch, b: DVec3) -> Vec<(u32, f64)> {
+        let plane = patch.plane;
+        self.backs
+            .faces
+            .par_iter()
+            .flat_map_iter(|&(g, start, end)| {
+                let side = self.scene.faces[g as usize].plane.flipped();
+                let pair = self.pair_on(&patch.poly, patch.face, &plane, g, side, None);
+                let mut out = Vec::new();
+                let Some(pair) = pair else { return out };
+                for q in start..end {
+                    // A back patch small as seen from the shooter takes the factor at its
+                    // centroid, as a far shooter gets one ray (`ONE_RAY_BELOW`).
+                    let back = &self.patches[q as usize];
+                    let size = back.radius / (back.centroid - patch.centroid).length();
+                    let points = &back.samples[if size < FEW_RAYS_BELOW { 0 } else { 1 }];
+                    let (lo, hi) = points.iter().fold((points[0], points[0]), |(lo, hi), x| {
+                        (lo.min(*x), hi.max(*x))
+                    });
+                    let group = Group {
+                        start: 0,
+                        end: 0,
+                        lo,
+                        hi,
+                    };
+                    let blockers = self.blockers(patch.face, &patch.poly, &plane, &pair, &group);
+                    let sum: f64 = points
+                        .iter()
+                        .map(|&x| self.receive_at(patch, &plane, &pair, &blockers, x, side.n, b))
+                        .sum();
+                    let gain = sum / points.len() as f64;
+                    if gain != 0.0 {
+                        out.push((q, gain));
+                    }
+                }
+                out
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod test {
+    use super::*;
+    use crate::scene::json::{LightJson, SceneJson, SettingsJson};
+    use crate::scenes::{cuboid, polygons_mesh};
+
+    fn quad(z: f64, h: f64, up: bool) -> Vec<[f64; 3]> {
+        let mut v = vec![[-h, -h, z], [h, -h, z], [h, h, z], [-h, h, z]];
+        if !up {
+            v.reverse();
+        }
+        v
+    }
+
+    fn scene(meshes: Vec<crate::scene::json::MeshJson>) -> Scene {
+        crate::scene::validate(&SceneJson {
+            format: "penumbra-scene".into(),
+            version: 1,
+            meshes,
+            lights: vec![LightJson {
+                name: "Bulb".into(),
+                point: Some([0.3, 0.2, 0.5]),
+                intensity: Some([1.0; 3]),
+                ..Default::default()
+            }],
+            settings: SettingsJson::default(),
+        })
+        .unwrap()
+    }
+
+    #[test]
+    fn only_thin_faces_with_something_behind_are_two_sided() {
+        // A floor with nothing under it; a plane facing up over it (the floor is behind
+        // it, facing it); a box above that (a solid); a black plane facing down, whose
+        // back sees the box but reflects nothing.
+        let sc = scene(vec![
+            polygons_mesh("Floor", vec![quad(0.0, 2.0, true)], None),
+            polygons_mesh("Plane", vec![quad(1.0, 1.0, true)], None),
+            polygons_mesh(
+                "Box",
+                cuboid([-0.5, -0.5, 1.5], [0.5, 0.5, 2.0], false),
+                None,
+            ),
+            polygons_mesh("Black", vec![quad(1.2, 0.2, false)], Some([0.0; 3])),
+        ]);
+        let emission = vec![DVec3::ZERO; sc.faces.len()];
+        assert_eq!(two_sided(&sc, &emission, 1e-9), vec![1]);
+        // Turned down with nothing above, the plane's back has nowhere to send light.
+        let sc = scene(vec![
+            polygons_mesh("Floor", vec![quad(0.0, 2.0, true)], None),
+            polygons_mesh("Plane", vec![quad(1.0, 1.0, false)], None),
+        ]);
+        let emission = vec![DVec3::ZERO; sc.faces.len()];
+        assert!(two_sided(&sc, &emission, 1e-9).is_empty());
+    }
+}
