@@ -127,46 +127,94 @@ struct View<'a> {
     ln: DVec3,
 }
 
-/// Buffers reused across one point's occluders.
+/// Buffers reused from one point to the next on each thread: the direct stage computes
+/// the visible light at hundreds of thousands of points, each under a dozen occluders, and
+/// allocating for every occluder and part cost a fifth of its time.
 #[derive(Default)]
 struct Scratch {
     occluder: Vec<DVec3>,
     a: Vec<DVec3>,
     b: Vec<DVec3>,
+    /// The hidden parts one after another: part k ends at `ends[k]`.
+    parts: Vec<DVec3>,
+    ends: Vec<usize>,
+    /// The light, then the parts, in the light's plane.
+    flat: Vec<DVec2>,
+    meta: Vec<Part>,
+    lifted: Vec<DVec3>,
+}
+
+impl Scratch {
+    fn start(&self, k: usize) -> usize {
+        if k == 0 {
+            0
+        } else {
+            self.ends[k - 1]
+        }
+    }
+}
+
+/// A hidden part with area, in the light's plane: `flat` indexes `Scratch::flat`.
+struct Part {
+    area: f64,
+    index: usize,
+    flat: std::ops::Range<usize>,
+    lo: DVec2,
+    hi: DVec2,
+}
+
+thread_local! {
+    static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::new(Scratch::default());
 }
 
 impl View<'_> {
     /// Irradiance per unit radiance from the visible part of the light; `blockers` are in
     /// world coordinates, `c` is the light's centroid (the origin of `self`).
     fn exact_visible(&self, blockers: &[&[DVec3]], c: DVec3, unoccluded: f64) -> f64 {
+        SCRATCH.with_borrow_mut(|s| self.exact_visible_in(s, blockers, c, unoccluded))
+    }
+
+    fn exact_visible_in(
+        &self,
+        s: &mut Scratch,
+        blockers: &[&[DVec3]],
+        c: DVec3,
+        unoccluded: f64,
+    ) -> f64 {
         let View { q, n, light, .. } = *self;
         let reach = light.iter().map(|l| (*l - q).length()).fold(0.0, f64::max);
-        let mut hidden: Vec<Vec<DVec3>> = Vec::with_capacity(blockers.len());
-        let mut scratch = Scratch::default();
+        s.parts.clear();
+        s.ends.clear();
         for o in blockers {
-            scratch.occluder.clear();
-            scratch.occluder.extend(o.iter().map(|v| *v - c));
-            if let Some(h) = self.hidden_part(&mut scratch, reach) {
+            s.occluder.clear();
+            s.occluder.extend(o.iter().map(|v| *v - c));
+            if self.hidden_part(&s.occluder, &mut s.a, &mut s.b, reach) {
                 // No clipping plane cut the light: all of it is hidden.
-                if h.as_slice() == light {
+                if s.a.as_slice() == light {
                     return 0.0;
                 }
-                hidden.push(h);
+                s.parts.extend_from_slice(&s.a);
+                s.ends.push(s.parts.len());
             }
         }
-        let covered = match hidden.len() {
+        let covered = match s.ends.len() {
             0 => return unoccluded,
-            1 => polygon_irradiance(q, n, &hidden[0]),
-            _ => match self.union_irradiance(&hidden) {
+            1 => polygon_irradiance(q, n, &s.parts),
+            _ => match self.union_irradiance(s) {
                 Some(e) => e,
-                None => return self.boolean_minus_union(&hidden).min(unoccluded),
+                None => {
+                    let hidden: Vec<Vec<DVec3>> = (0..s.ends.len())
+                        .map(|k| s.parts[s.start(k)..s.ends[k]].to_vec())
+                        .collect();
+                    return self.boolean_minus_union(&hidden).min(unoccluded);
+                }
             },
         };
         // The hidden parts lie inside the light, so the visible integral is a difference.
         (unoccluded - covered).clamp(0.0, unoccluded)
     }
 
-    /// Irradiance per unit radiance from the union of several hidden parts, as a sum over
+    /// Irradiance per unit radiance from the union of the hidden parts in `s`, as a sum over
     /// disjoint convex pieces: each part (largest first) minus the parts before it, in the
     /// light's plane. A part whose bounds meet no earlier part's is a piece as it stands, so
     /// small occluders side by side (each hiding its own patch of the light) cost one
@@ -177,63 +225,72 @@ impl View<'_> {
     /// The visible light is the unoccluded integral minus this sum, so where nearly all the
     /// light is hidden its absolute error is that of the sum, a few ulps of the unoccluded
     /// value. Pieces of area below 1e-15 of the light's (clipping slivers) are left out.
-    fn union_irradiance(&self, hidden: &[Vec<DVec3>]) -> Option<f64> {
+    fn union_irradiance(&self, s: &mut Scratch) -> Option<f64> {
         let View { q, n, .. } = *self;
         let frame = Frame::new(DVec3::ZERO, self.ln);
-        let flat = |c: &[DVec3]| -> Vec<DVec2> {
-            let mut f: Vec<DVec2> = c.iter().map(|v| frame.to_2d(*v)).collect();
-            if signed_area_2d(&f) < 0.0 {
-                f.reverse();
+        // The light and the parts in the light's plane, counter-clockwise.
+        let flatten = |c: &[DVec3], out: &mut Vec<DVec2>| {
+            let start = out.len();
+            out.extend(c.iter().map(|v| frame.to_2d(*v)));
+            if signed_area_2d(&out[start..]) < 0.0 {
+                out[start..].reverse();
             }
-            f
+            signed_area_2d(&out[start..])
         };
-        let min_area = 1e-15 * signed_area_2d(&flat(self.light));
-        struct Part {
-            area: f64,
-            index: usize,
-            flat: Vec<DVec2>,
-            lo: DVec2,
-            hi: DVec2,
-        }
-        let mut parts: Vec<Part> = hidden
-            .iter()
-            .enumerate()
-            .map(|(index, h)| {
-                let flat = flat(h);
-                let (lo, hi) = bounds(&flat);
-                Part {
-                    area: signed_area_2d(&flat),
-                    index,
-                    flat,
+        s.flat.clear();
+        let min_area = 1e-15 * flatten(self.light, &mut s.flat);
+        s.flat.clear();
+        s.meta.clear();
+        for k in 0..s.ends.len() {
+            let start = s.flat.len();
+            let area = flatten(&s.parts[s.start(k)..s.ends[k]], &mut s.flat);
+            if area > min_area {
+                let (lo, hi) = bounds(&s.flat[start..]);
+                s.meta.push(Part {
+                    area,
+                    index: k,
+                    flat: start..s.flat.len(),
                     lo,
                     hi,
-                }
-            })
-            .filter(|p| p.area > min_area)
-            .collect();
-        parts.sort_by(|a, b| b.area.total_cmp(&a.area).then(a.index.cmp(&b.index)));
-        let limit = 8 * hidden.len() + 32;
+                });
+            }
+        }
+        s.meta
+            .sort_by(|a, b| b.area.total_cmp(&a.area).then(a.index.cmp(&b.index)));
+        let limit = 8 * s.ends.len() + 32;
         let (mut total, mut count) = (0.0, 0);
         let (mut pieces, mut next): (Vec<Vec<DVec2>>, Vec<Vec<DVec2>>) = (Vec::new(), Vec::new());
-        let mut lifted: Vec<DVec3> = Vec::new();
-        for (k, part) in parts.iter().enumerate() {
+        let Scratch {
+            parts,
+            ends,
+            flat,
+            meta,
+            lifted,
+            ..
+        } = s;
+        for (k, part) in meta.iter().enumerate() {
             let apart = |o: &Part| {
                 o.hi.x <= part.lo.x
                     || o.hi.y <= part.lo.y
                     || o.lo.x >= part.hi.x
                     || o.lo.y >= part.hi.y
             };
-            if parts[..k].iter().all(apart) {
-                total += polygon_irradiance(q, n, &hidden[part.index]);
+            if meta[..k].iter().all(apart) {
+                let start = if part.index == 0 {
+                    0
+                } else {
+                    ends[part.index - 1]
+                };
+                total += polygon_irradiance(q, n, &parts[start..ends[part.index]]);
                 count += 1;
                 continue;
             }
             pieces.clear();
-            pieces.push(part.flat.clone());
-            for earlier in parts[..k].iter().filter(|o| !apart(o)) {
+            pieces.push(flat[part.flat.clone()].to_vec());
+            for earlier in meta[..k].iter().filter(|o| !apart(o)) {
                 next.clear();
                 for p in pieces.drain(..) {
-                    subtract_convex(p, &earlier.flat, min_area, &mut next);
+                    subtract_convex(p, &flat[earlier.flat.clone()], min_area, &mut next);
                 }
                 std::mem::swap(&mut pieces, &mut next);
                 if pieces.is_empty() {
@@ -247,7 +304,7 @@ impl View<'_> {
             for p in &pieces {
                 lifted.clear();
                 lifted.extend(p.iter().map(|x| frame.to_3d(*x)));
-                total += polygon_irradiance(q, n, &lifted);
+                total += polygon_irradiance(q, n, lifted);
             }
         }
         Some(total)
@@ -280,28 +337,29 @@ impl View<'_> {
         contours_irradiance(self.q, self.n, &contours)
     }
 
-    /// The part of the light that convex occluder `scratch.occluder` (relative to the light's
-    /// centroid) hides from `q`, or `None` when nothing with area is hidden. `reach` is the
-    /// largest distance from `q` to the light.
-    fn hidden_part(&self, scratch: &mut Scratch, reach: f64) -> Option<Vec<DVec3>> {
+    /// Puts into `part` the part of the light that convex occluder `o` (relative to the
+    /// light's centroid) hides from `q`; `false` when nothing with area is hidden. `reach` is
+    /// the largest distance from `q` to the light; `next` is a buffer.
+    fn hidden_part(
+        &self,
+        o: &[DVec3],
+        part: &mut Vec<DVec3>,
+        next: &mut Vec<DVec3>,
+        reach: f64,
+    ) -> bool {
         let (q, light) = (self.q, self.light);
-        let Scratch {
-            occluder: o,
-            a: part,
-            b: next,
-        } = scratch;
         if o.len() < 3 {
-            return None;
+            return false;
         }
         let no = newell_normal(o).normalize_or_zero();
         if no == DVec3::ZERO {
-            return None;
+            return false;
         }
         let co = o.iter().copied().sum::<DVec3>() / o.len() as f64;
         let h = no.dot(q - co);
         let size = o.iter().map(|v| (*v - q).length()).fold(0.0, f64::max);
         if !(h.abs() > TOUCH * size) {
-            return None;
+            return false;
         }
         let s = h.signum();
         // O's plane first: it discards the whole light in the common case of an occluder that is
@@ -311,19 +369,19 @@ impl View<'_> {
         clip_polygon_3d_into(light, &plane, 0.0, part);
         for i in 0..o.len() {
             if part.len() < 3 {
-                return None;
+                return false;
             }
             let (a, b) = (o[i] - q, o[(i + 1) % o.len()] - q);
             // With O counter-clockwise about `no`, its inside is where (a × b)·(x − q) has
             // the sign of −h; the sign of h turns this around for an occluder facing away.
             let m = (-s * a.cross(b)).normalize_or_zero();
             if m == DVec3::ZERO {
-                return None;
+                return false;
             }
             clip_polygon_3d_into(part, &Plane::new(m, m.dot(q)), 0.0, next);
             std::mem::swap(part, next);
         }
-        (part.len() >= 3).then(|| part.clone())
+        part.len() >= 3
     }
 
     /// Integrand-weighted visible fraction of the light from `samples` stratified points

@@ -11,6 +11,7 @@ pub mod sizing;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::{DVec2, DVec3};
+use rayon::prelude::*;
 
 use crate::geom::Frame;
 use spade::handles::FixedVertexHandle;
@@ -414,12 +415,13 @@ fn extract(
         };
     }
     let mut comp = vec![u32::MAX; faces.len()];
-    let mut regions: Vec<Region> = Vec::new();
+    // The largest triangle of each component, whose centre is classified.
+    let mut largest: Vec<usize> = Vec::new();
     for start in 0..faces.len() {
         if comp[start] != u32::MAX {
             continue;
         }
-        let id = regions.len() as u32;
+        let id = largest.len() as u32;
         let mut stack = vec![start];
         comp[start] = id;
         let mut best = (0.0f64, start);
@@ -441,9 +443,17 @@ fn extract(
                 }
             }
         }
-        let c = faces[best.1].center();
-        regions.push(rr.classify(DVec2::new(c.x, c.y) - shift));
+        largest.push(best.1);
     }
+    // A dense receiver has hundreds of thousands of components, each classified on its own.
+    let centres: Vec<DVec2> = largest
+        .iter()
+        .map(|&t| {
+            let c = faces[t].center();
+            DVec2::new(c.x, c.y) - shift
+        })
+        .collect();
+    let regions: Vec<Region> = centres.par_iter().map(|&c| rr.classify(c)).collect();
 
     // D0 split: group the triangles around each vertex into sectors that do not cross a
     // lit|umbra edge; every sector but the first gets its own copy of the vertex.
