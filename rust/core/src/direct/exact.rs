@@ -7,8 +7,10 @@
 //! points `l` for which the segment `[p, l]` meets `O`: the light clipped by the planes through
 //! `p` and each edge of `O` (keeping `O`'s side) and by `O`'s plane (keeping the far side).
 //! Clipping by planes through `p` never projects anything to infinity, so occluders beside,
-//! behind or crossing the light need no special case. Several hidden parts overlap, so their
-//! union is taken in the light's plane with `i_overlay` before the contour integral.
+//! behind or crossing the light need no special case. Hidden parts may overlap, so their
+//! union is cut into disjoint convex pieces in the light's plane (each part minus the parts
+//! before it), and the visible light is the unoccluded integral minus the pieces'; where
+//! the pieces multiply, a general polygon boolean (`i_overlay`) takes over.
 //!
 //! Penumbra, sampled (the paper's way): the exact unoccluded integral times the visible
 //! fraction of stratified points on the light. The paper counts points; here each point is
