@@ -7,16 +7,23 @@
 //! - 1 and 2 threads give identical output.
 //!
 //! Indirect light is off (it is being replaced, and it is not what can lose geometry); the
-//! scenes are tiny so the whole run stays well under a minute in `--release`.
+//! scenes are tiny so the whole run stays well under a minute in `--release`. A second run
+//! puts the same scenes under round lights, spots and suns with an angle, with some meshes
+//! as scenery (no output, indirect light on, meshed coarsely).
 
 mod common;
 use common::*;
-use penumbra::scene::json::{LightJson, SceneJson, SettingsJson};
+use penumbra::scene::json::{LightJson, SceneJson, SettingsJson, SpotJson};
 use penumbra::{BakeError, Progress};
 
 const SCENES: u64 = 300;
 
-fn random_scene(seed: u64) -> SceneJson {
+/// Scenes under this round's lights: fewer, since a few have indirect light on.
+const ROUND_SCENES: u64 = 150;
+
+/// The random scene of `seed`; with `round`, under a round point or sphere, a spot (cone,
+/// blend, radius) or a sun with an angle, some meshes being scenery with indirect light on.
+fn random_scene(seed: u64, round: bool) -> SceneJson {
     let mut r = Rng(seed.wrapping_mul(0x2545_F491_4F6C_DD1D) ^ 0xDEAD_BEEF);
     // Scale and offset: mostly ordinary, sometimes extreme (inside or outside the contract).
     let scale = match seed % 7 {
@@ -84,6 +91,9 @@ fn random_scene(seed: u64) -> SceneJson {
         };
         meshes.push(mesh(&name, polys));
     }
+    if round {
+        return round_lit(seed, meshes, r, scale, offset);
+    }
     let lights = match seed % 3 {
         0 => vec![area_light(
             "Key",
@@ -117,6 +127,75 @@ fn random_scene(seed: u64) -> SceneJson {
     s
 }
 
+fn round_lit(
+    seed: u64,
+    mut meshes: Vec<penumbra::scene::json::MeshJson>,
+    mut r: Rng,
+    scale: f64,
+    offset: [f64; 3],
+) -> SceneJson {
+    let at = |r: &mut Rng| [r.range(-1., 1.), r.range(-1., 1.), r.range(1.8, 3.0)];
+    let spot = |r: &mut Rng| SpotJson {
+        direction: [r.range(-0.4, 0.4), r.range(-0.4, 0.4), -1.0],
+        angle: r.range(0.3, 2.5),
+        blend: r.range(0.0, 1.0),
+    };
+    let light = match seed % 4 {
+        0 => LightJson {
+            name: "Round".into(),
+            point: Some(at(&mut r)),
+            intensity: Some([1.0; 3]),
+            radius: Some(r.range(0.05, 0.4)),
+            sphere: Some(r.next() < 0.5),
+            ..Default::default()
+        },
+        1 => LightJson {
+            name: "Spot".into(),
+            point: Some(at(&mut r)),
+            intensity: Some([1.0; 3]),
+            spot: Some(spot(&mut r)),
+            ..Default::default()
+        },
+        2 => LightJson {
+            name: "RoundSpot".into(),
+            point: Some(at(&mut r)),
+            intensity: Some([1.0; 3]),
+            spot: Some(spot(&mut r)),
+            radius: Some(r.range(0.05, 0.3)),
+            ..Default::default()
+        },
+        _ => LightJson {
+            name: "Sun".into(),
+            direction: Some([r.range(-0.5, 0.5), r.range(-0.5, 0.5), -1.0]),
+            irradiance: Some([1.0; 3]),
+            angle: Some(r.range(0.01, 0.3)),
+            ..Default::default()
+        },
+    };
+    // Scenery (with indirect light only, which is slower: one scene in five).
+    let indirect = seed % 5 == 0;
+    if indirect {
+        for m in meshes.iter_mut().skip(1) {
+            if r.next() < 0.5 {
+                m.output = Some(false);
+            }
+        }
+    }
+    let mut s = scene(
+        meshes,
+        vec![light],
+        SettingsJson {
+            indirect: Some(indirect),
+            element_size: Some(0.5),
+            penumbra_element_size: Some(0.25),
+            patch_size: Some(0.5),
+            ..Default::default()
+        },
+    );
+    transform(&mut s, scale, offset);
+    s
+}
+
 fn transform(s: &mut SceneJson, scale: f64, offset: [f64; 3]) {
     let map = |p: &mut [f64; 3]| {
         for k in 0..3 {
@@ -129,10 +208,12 @@ fn transform(s: &mut SceneJson, scale: f64, offset: [f64; 3]) {
     for l in &mut s.lights {
         l.polygon.iter_mut().flatten().for_each(map);
         l.point.iter_mut().for_each(map);
+        l.radius = l.radius.map(|v| v * scale);
     }
     for x in [
         &mut s.settings.element_size,
         &mut s.settings.penumbra_element_size,
+        &mut s.settings.patch_size,
     ] {
         *x = x.map(|v| v * scale);
     }
@@ -143,7 +224,11 @@ fn run(s: &SceneJson, threads: u32) -> Result<String, BakeError> {
     s.settings.threads = Some(threads);
     let sc = penumbra::scene::validate(&s)?;
     let b = penumbra::bake(&sc, &Progress::new())?;
-    for m in &b.meshes {
+    for (m, input) in b.meshes.iter().zip(&s.meshes) {
+        if input.output == Some(false) {
+            assert!(m.triangles.is_empty(), "scenery {:?} has output", m.name);
+            continue;
+        }
         assert!(
             !m.triangles.is_empty(),
             "mesh {:?} lost all its triangles",
@@ -158,9 +243,18 @@ fn run(s: &SceneJson, threads: u32) -> Result<String, BakeError> {
 
 #[test]
 fn random_scenes_bake_whole_or_are_refused() {
+    bake_whole_or_refused(SCENES, false);
+}
+
+#[test]
+fn random_scenes_under_round_lights_spots_and_scenery_bake_whole_or_are_refused() {
+    bake_whole_or_refused(ROUND_SCENES, true);
+}
+
+fn bake_whole_or_refused(scenes: u64, round: bool) {
     let (mut baked, mut refused) = (0, 0);
-    for seed in 0..SCENES {
-        let s = random_scene(seed);
+    for seed in 0..scenes {
+        let s = random_scene(seed, round);
         let one = std::panic::catch_unwind(|| run(&s, 1));
         let one = match one {
             Ok(r) => r,
@@ -191,6 +285,6 @@ fn random_scenes_bake_whole_or_are_refused() {
         }
     }
     // The generator must exercise both outcomes, mostly baking.
-    assert!(baked > SCENES * 2 / 3, "only {baked} of {SCENES} baked");
+    assert!(baked > scenes * 2 / 3, "only {baked} of {scenes} baked");
     assert!(refused > 0, "no scene was outside the contract");
 }

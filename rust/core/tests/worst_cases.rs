@@ -3,7 +3,7 @@
 
 mod common;
 use common::*;
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use penumbra::direct::exact::area_light as exact_area_light;
 use penumbra::geom::Plane;
 use penumbra::regions::relation::Relation;
@@ -101,11 +101,11 @@ fn a_many_edged_occluder_changes_the_light_by_less_than_its_simplification_band(
 /// splitting the side into thousands of pieces, a triangle each (on quads2000 it filled its
 /// whole allowance, four times the arrangement's vertices). Without them the floor has
 /// about two triangles a vertex, as a planar mesh should.
-#[test]
-fn refinement_under_many_shadows_completes_with_two_triangles_per_vertex() {
-    let side = 20;
+/// `side` × `side` small quads at 13 heights in 0.5–0.8 over a 4 × 4 floor, under the lamp
+/// (quads2000 is 45 × 45).
+fn quads(side: usize) -> Vec<Vec<[f64; 3]>> {
     let step = 3.0 / side as f64;
-    let quads: Vec<Vec<[f64; 3]>> = (0..side * side)
+    (0..side * side)
         .map(|k| {
             let (i, j) = ((k % side) as f64, (k / side) as f64);
             let z = 0.5 + 0.3 * ((k * 7919) % 13) as f64 / 13.0;
@@ -116,16 +116,23 @@ fn refinement_under_many_shadows_completes_with_two_triangles_per_vertex() {
                 true,
             )
         })
-        .collect();
-    let s = scene(
+        .collect()
+}
+
+fn quads_scene(side: usize) -> penumbra::scene::json::SceneJson {
+    scene(
         vec![
             mesh("Floor", vec![quad([0., 0., 0.], 2., 2., true)]),
-            mesh("Quads", quads),
+            mesh("Quads", quads(side)),
         ],
         vec![area_light("Lamp", lamp())],
         settings(),
-    );
-    let b = bake(&s);
+    )
+}
+
+#[test]
+fn refinement_under_many_shadows_completes_with_two_triangles_per_vertex() {
+    let b = bake(&quads_scene(20));
     let floor = &b.meshes[0];
     let (nv, nt) = (floor.positions.len(), floor.triangles.len());
     // Before the fix: 61.9k floor vertices, 9.4k of them on its boundary, 1.85 triangles a
@@ -142,5 +149,117 @@ fn refinement_under_many_shadows_completes_with_two_triangles_per_vertex() {
     assert!(
         on_boundary < 2_000,
         "{on_boundary} of {nv} vertices on the boundary"
+    );
+}
+
+/// The floor under 400 quads: its arrangement tests its candidate pairs of edges in
+/// parallel and applies what they find in pair order, so the bake is the same, bit for bit,
+/// on one thread and on four.
+#[test]
+fn many_shadows_bake_the_same_on_one_and_four_threads() {
+    let mut s = quads_scene(20);
+    let mut out = Vec::new();
+    for threads in [1, 4] {
+        s.settings.threads = Some(threads);
+        out.push(serde_json::to_string(&bake(&s).meshes).unwrap());
+    }
+    assert!(out[0] == out[1], "1 and 4 threads differ");
+}
+
+/// The floor under 400 quads against the exact light (every quad a candidate occluder) on a
+/// 151 × 151 probe grid, the baked vertex values interpolated linearly: what the mesh
+/// promises in values. Measured (error over the unoccluded light): RMS 1.34e-3, worst
+/// 1.79e-2, on 65.6k floor vertices. Without Delaunay refinement (the arrangement's 14k
+/// vertices alone; 301 × 301 probes) it was RMS 7.4e-3, worst 0.126: the bounds below
+/// catch a mesher that stops refining.
+#[test]
+fn the_floor_under_many_shadows_follows_the_exact_light() {
+    let b = bake(&quads_scene(20));
+    let floor = &b.meshes[0];
+    let light: Vec<DVec3> = lamp().into_iter().map(DVec3::from).collect();
+    let plane = Plane::from_polygon(&light).unwrap();
+    let occ: Vec<Vec<DVec3>> = quads(20)
+        .iter()
+        .map(|q| q.iter().map(|v| DVec3::from(*v)).collect())
+        .collect();
+    let blockers: Vec<&[DVec3]> = occ.iter().map(|v| v.as_slice()).collect();
+    let exact = |p: DVec3, rel, blockers: &[&[DVec3]]| {
+        exact_area_light(
+            p,
+            DVec3::Z,
+            &light,
+            &plane,
+            DVec3::ONE,
+            rel,
+            blockers,
+            PenumbraVisibility::Exact,
+            0,
+        )
+        .x
+    };
+    let full = exact(DVec3::ZERO, Relation::Lit, &[]);
+    // Triangles by the cells of a 200 × 200 grid over the floor.
+    let pos: Vec<DVec2> = floor
+        .positions
+        .iter()
+        .map(|p| DVec2::new(p[0], p[1]))
+        .collect();
+    let g = 200usize;
+    let cell = |x: f64| (((x + 2.0) / 4.0 * g as f64).floor().max(0.0) as usize).min(g - 1);
+    let mut cells = vec![Vec::new(); g * g];
+    for (ti, t) in floor.triangles.iter().enumerate() {
+        let [a, b, c] = t.map(|i| pos[i as usize]);
+        let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
+        for i in cell(lo.x)..=cell(hi.x) {
+            for j in cell(lo.y)..=cell(hi.y) {
+                cells[j * g + i].push(ti);
+            }
+        }
+    }
+    let interpolated = |q: DVec2| -> Option<f64> {
+        cells[cell(q.y) * g + cell(q.x)].iter().find_map(|&ti| {
+            let t = floor.triangles[ti];
+            let [a, b, c] = t.map(|i| pos[i as usize]);
+            let d = (b - a).perp_dot(c - a);
+            let w = [
+                (b - q).perp_dot(c - q) / d,
+                (c - q).perp_dot(a - q) / d,
+                (a - q).perp_dot(b - q) / d,
+            ];
+            w.iter().all(|&x| x >= -1e-12).then(|| {
+                (0..3)
+                    .map(|k| w[k] * floor.colors[t[k] as usize][0] * PI)
+                    .sum()
+            })
+        })
+    };
+    let n = 151;
+    let (mut sum2, mut worst, mut probes) = (0.0, 0.0f64, 0);
+    for i in 0..n {
+        for j in 0..n {
+            let at = |k: usize, f: f64| -1.7 + 3.4 * (k as f64 + f) / n as f64;
+            let q = DVec2::new(at(i, 0.37), at(j, 0.61));
+            let v = interpolated(q).expect("every probe lies on the floor");
+            let want = exact(q.extend(0.0), Relation::Penumbra, &blockers);
+            let err = (v - want).abs() / full;
+            sum2 += err * err;
+            worst = worst.max(err);
+            probes += 1;
+        }
+    }
+    let rms = (sum2 / probes as f64).sqrt();
+    eprintln!(
+        "{} floor vertices; RMS error {rms:.3e}, worst {worst:.3e} of the unoccluded light",
+        floor.positions.len()
+    );
+    assert!(rms < 2e-3, "RMS error {rms:e} of the unoccluded light");
+    assert!(
+        worst < 4e-2,
+        "worst error {worst:e} of the unoccluded light"
+    );
+    assert!(
+        floor.positions.len() < 80_000,
+        "{} floor vertices",
+        floor.positions.len()
     );
 }

@@ -1,11 +1,14 @@
 //! Random geometry: the fuzzer's bytes become a floor and a few boxes, quads and triangles
-//! at a random scale and offset, under one light. Every such scene must bake with nothing
-//! lost (`coverage::check` runs inside `bake`, so a "geometry lost" error is a failure) or
-//! be refused on one line by the precision contract; colours finite and ≥ 0.
+//! at a random scale and offset, under one light of any kind (area, point, round point or
+//! sphere, spot with a cone, blend and radius, sun with or without an angle). Some meshes
+//! may have no output, and indirect light may be on, so that scenery is meshed coarsely.
+//! Every such scene must bake with nothing lost (`coverage::check` runs inside `bake`, so a
+//! "geometry lost" error is a failure) or be refused on one line by the precision
+//! contract; colours finite and ≥ 0.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use penumbra::scene::json::{LightJson, MeshJson, SceneJson, SettingsJson};
+use penumbra::scene::json::{LightJson, MeshJson, SceneJson, SettingsJson, SpotJson};
 use penumbra::{BakeError, Progress};
 
 /// Reads the input as a stream of small numbers.
@@ -112,9 +115,47 @@ fuzz_target!(|data: &[u8]| {
                 })
                 .collect(),
         };
-        meshes.push(mesh(format!("M{k}"), polys));
+        let mut m = mesh(format!("M{k}"), polys);
+        m.output = (b.u8() % 4 == 0).then_some(false);
+        meshes.push(m);
     }
-    let light = match b.u8() % 3 {
+    let radius = b.range(0.0, 0.4);
+    let spot = |b: &mut Bytes| SpotJson {
+        direction: [b.range(-0.5, 0.5), b.range(-0.5, 0.5), -1.0],
+        angle: b.range(0.1, 3.0),
+        blend: b.range(0.0, 1.0),
+    };
+    let light = match b.u8() % 7 {
+        3 => LightJson {
+            name: "L".into(),
+            point: Some([b.range(-1.0, 1.0), b.range(-1.0, 1.0), b.range(0.0, 3.0)]),
+            intensity: Some([1.0; 3]),
+            radius: Some(radius),
+            sphere: Some(b.u8() % 2 == 0),
+            ..Default::default()
+        },
+        4 => LightJson {
+            name: "L".into(),
+            point: Some([b.range(-1.0, 1.0), b.range(-1.0, 1.0), b.range(0.0, 3.0)]),
+            intensity: Some([1.0; 3]),
+            spot: Some(spot(&mut b)),
+            ..Default::default()
+        },
+        5 => LightJson {
+            name: "L".into(),
+            point: Some([b.range(-1.0, 1.0), b.range(-1.0, 1.0), b.range(0.0, 3.0)]),
+            intensity: Some([1.0; 3]),
+            spot: Some(spot(&mut b)),
+            radius: Some(radius),
+            ..Default::default()
+        },
+        6 => LightJson {
+            name: "L".into(),
+            direction: Some([b.range(-1.0, 1.0), b.range(-1.0, 1.0), -1.0]),
+            irradiance: Some([1.0; 3]),
+            angle: Some(b.range(0.0, 0.5)),
+            ..Default::default()
+        },
         0 => LightJson {
             name: "L".into(),
             polygon: Some(vec![
@@ -145,7 +186,10 @@ fuzz_target!(|data: &[u8]| {
         meshes,
         lights: vec![light],
         settings: SettingsJson {
-            indirect: Some(false),
+            // Indirect light only now and then: it is the slow stage, and scenery meshing
+            // (meshes without output) happens only with it on.
+            indirect: Some(b.u8() % 8 == 0),
+            patch_size: Some(0.5 * scale),
             threads: Some(1),
             element_size: Some(0.5 * scale),
             ..Default::default()
@@ -162,6 +206,7 @@ fuzz_target!(|data: &[u8]| {
     for l in &mut s.lights {
         l.polygon.iter_mut().flatten().for_each(map);
         l.point.iter_mut().for_each(map);
+        l.radius = l.radius.map(|r| r * scale);
     }
     let result = penumbra::scene::validate(&s).and_then(|sc| penumbra::bake(&sc, &Progress::new()));
     match result {

@@ -68,21 +68,27 @@ fn horizon_clipped_sum(p: DVec3, n: DVec3, contour: &[DVec3]) -> f64 {
     if k < 3 {
         return 0.0;
     }
-    let rel: Vec<DVec3> = contour.iter().map(|x| *x - p).collect();
-    let h: Vec<f64> = rel.iter().map(|r| r.dot(n)).collect();
-    if h.iter().all(|&x| x <= 0.0) {
+    // No buffers here: the direct stage sums millions of small contours.
+    let (mut below, mut above) = (true, true);
+    for x in contour {
+        let h = (*x - p).dot(n);
+        below &= h <= 0.0;
+        above &= h >= 0.0;
+    }
+    if below {
         return 0.0;
     }
-    if h.iter().all(|&x| x >= 0.0) {
+    if above {
         // Differences of the caller's coordinates are exact for nearby vertices, which keeps a
         // small far polygon's shape intact (see the module's Precision note).
         return (0..k)
             .map(|i| {
                 let j = (i + 1) % k;
-                edge_term(n, rel[i], contour[j] - contour[i], rel[j])
+                edge_term(n, contour[i] - p, contour[j] - contour[i], contour[j] - p)
             })
             .sum();
     }
+    let rel: Vec<DVec3> = contour.iter().map(|x| *x - p).collect();
     let clipped = clip_polygon_3d(&rel, &Plane::new(n, 0.0), 0.0);
     let m = clipped.len();
     (0..m)

@@ -10,21 +10,37 @@ use super::Plane;
 /// Vertices within `eps` of the plane count as on it, so a polygon touching the plane
 /// is not split into slivers.
 pub fn clip_polygon_3d(poly: &[DVec3], plane: &Plane, eps: f64) -> Vec<DVec3> {
+    let mut out = Vec::with_capacity(poly.len() + 2);
+    clip_polygon_3d_into(poly, plane, eps, &mut out);
+    out
+}
+
+/// [`clip_polygon_3d`] into `out` (cleared first). It allocates nothing when `out` has room,
+/// which matters to the direct stage: it clips a light polygon tens of millions of times.
+pub fn clip_polygon_3d_into(poly: &[DVec3], plane: &Plane, eps: f64, out: &mut Vec<DVec3>) {
+    out.clear();
     let n = poly.len();
-    let mut out = Vec::with_capacity(n + 2);
     if n == 0 {
-        return out;
+        return;
     }
-    let d: Vec<f64> = poly.iter().map(|p| plane.dist(*p)).collect();
-    if d.iter().all(|&x| x >= -eps) {
-        return poly.to_vec();
+    let (mut keep_all, mut drop_all) = (true, true);
+    for p in poly {
+        let d = plane.dist(*p);
+        keep_all &= d >= -eps;
+        drop_all &= d <= eps;
     }
-    if d.iter().all(|&x| x <= eps) {
-        return out;
+    if keep_all {
+        out.extend_from_slice(poly);
+        return;
     }
+    if drop_all {
+        return;
+    }
+    let mut da = plane.dist(poly[0]);
     for i in 0..n {
         let j = (i + 1) % n;
-        let (a, b, da, db) = (poly[i], poly[j], d[i], d[j]);
+        let (a, b) = (poly[i], poly[j]);
+        let db = plane.dist(b);
         if da >= -eps {
             out.push(a);
         }
@@ -32,8 +48,8 @@ pub fn clip_polygon_3d(poly: &[DVec3], plane: &Plane, eps: f64) -> Vec<DVec3> {
             let t = da / (da - db);
             out.push(a + (b - a) * t);
         }
+        da = db;
     }
-    out
 }
 
 /// A 2-D half-plane `n·x ≥ c` (n need not be unit length).
@@ -53,22 +69,38 @@ impl HalfPlane {
 /// Keeps the part of a convex 2-D polygon inside `h`. `eps` is in the units of `h.eval`
 /// divided by |n| (i.e. a distance).
 pub fn clip_polygon_2d(poly: &[DVec2], h: &HalfPlane, eps: f64) -> Vec<DVec2> {
+    let mut out = Vec::with_capacity(poly.len() + 2);
+    clip_polygon_2d_into(poly, h, eps, &mut out);
+    out
+}
+
+/// [`clip_polygon_2d`] into `out` (cleared first), allocating nothing when `out` has room.
+pub fn clip_polygon_2d_into(poly: &[DVec2], h: &HalfPlane, eps: f64, out: &mut Vec<DVec2>) {
+    out.clear();
     let n = poly.len();
-    let mut out = Vec::with_capacity(n + 2);
     if n == 0 {
-        return out;
+        return;
     }
     let inv = 1.0 / h.n.length();
-    let d: Vec<f64> = poly.iter().map(|p| h.eval(*p) * inv).collect();
-    if d.iter().all(|&x| x >= -eps) {
-        return poly.to_vec();
+    let dist = |p: DVec2| h.eval(p) * inv;
+    let (mut keep_all, mut drop_all) = (true, true);
+    for p in poly {
+        let d = dist(*p);
+        keep_all &= d >= -eps;
+        drop_all &= d <= eps;
     }
-    if d.iter().all(|&x| x <= eps) {
-        return out;
+    if keep_all {
+        out.extend_from_slice(poly);
+        return;
     }
+    if drop_all {
+        return;
+    }
+    let mut da = dist(poly[0]);
     for i in 0..n {
         let j = (i + 1) % n;
-        let (a, b, da, db) = (poly[i], poly[j], d[i], d[j]);
+        let (a, b) = (poly[i], poly[j]);
+        let db = dist(b);
         if da >= -eps {
             out.push(a);
         }
@@ -76,8 +108,8 @@ pub fn clip_polygon_2d(poly: &[DVec2], h: &HalfPlane, eps: f64) -> Vec<DVec2> {
             let t = da / (da - db);
             out.push(a + (b - a) * t);
         }
+        da = db;
     }
-    out
 }
 
 /// Convex counter-clockwise `piece` minus convex counter-clockwise `c`, as disjoint convex
@@ -98,6 +130,7 @@ pub fn subtract_convex(piece: Vec<DVec2>, c: &[DVec2], min_area: f64, out: &mut 
     // its length squared.
     let tiny = (hi - lo).max_element() * 1e-12;
     let mut rest = piece;
+    let mut next = Vec::with_capacity(rest.len() + n);
     for k in 0..n {
         let (a, b) = (c[k], c[(k + 1) % n]);
         let nrm = (b - a).perp();
@@ -117,7 +150,8 @@ pub fn subtract_convex(piece: Vec<DVec2>, c: &[DVec2], min_area: f64, out: &mut 
         if part.len() >= 3 && signed_area_2d(&part) > min_area {
             out.push(part);
         }
-        rest = clip_polygon_2d(&rest, &inside, 0.0);
+        clip_polygon_2d_into(&rest, &inside, 0.0, &mut next);
+        std::mem::swap(&mut rest, &mut next);
         if rest.len() < 3 {
             return;
         }

@@ -8,10 +8,10 @@ pub mod cancel;
 pub mod elements;
 pub mod sizing;
 
-use std::collections::HashMap;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::{DVec2, DVec3};
+use rayon::prelude::*;
 
 use crate::geom::Frame;
 use spade::handles::FixedVertexHandle;
@@ -57,14 +57,16 @@ pub fn mesh_receiver(
     let arr = &rr.arrangement;
     let shift = shift_away_from_zero(&arr.vertices);
     let mut cdt = Cdt::new();
-    let mut handle: HashMap<u32, FixedVertexHandle> = HashMap::new();
+    let mut handle: Vec<Option<FixedVertexHandle>> = vec![None; arr.vertices.len()];
+    let mut inserted = 0usize;
     let mut vh = |cdt: &mut Cdt, v: u32| -> Option<FixedVertexHandle> {
-        if let Some(h) = handle.get(&v) {
-            return Some(*h);
+        if let Some(h) = handle[v as usize] {
+            return Some(h);
         }
         let p = arr.vertices[v as usize] + shift;
         let h = cdt.insert(Point2::new(p.x, p.y)).ok()?;
-        handle.insert(v, h);
+        handle[v as usize] = Some(h);
+        inserted += 1;
         Some(h)
     };
     for (k, &e) in rr.kept_edges.iter().enumerate() {
@@ -99,7 +101,7 @@ pub fn mesh_receiver(
         };
         graded_lattice(&arr.vertices, f, &size, &mut seeds);
     }
-    let used = budget.fetch_add(seeds.len() as u64 + handle.len() as u64, Ordering::Relaxed)
+    let used = budget.fetch_add(seeds.len() as u64 + inserted as u64, Ordering::Relaxed)
         + seeds.len() as u64;
     if used > settings.max_elements {
         return Err(BakeError::setting(
@@ -110,7 +112,7 @@ pub fn mesh_receiver(
             ),
         ));
     }
-    let dense = handle.len() > DENSE_RATIO * seeds.len().max(1);
+    let dense = inserted > DENSE_RATIO * seeds.len().max(1);
     for (k, p) in seeds.into_iter().enumerate() {
         if k % 4096 == 0 {
             progress.check()?;
@@ -137,7 +139,7 @@ pub fn mesh_receiver(
         progress,
     )?;
     budget.fetch_add(
-        cdt.num_vertices() as u64 - handle.len() as u64,
+        cdt.num_vertices() as u64 - inserted as u64,
         Ordering::Relaxed,
     );
     if settings.uniform {
@@ -386,11 +388,15 @@ fn extract(
         .map(|v| DVec2::new(v.position().x, v.position().y) - shift)
         .collect();
     let faces: Vec<_> = cdt.inner_faces().collect();
-    let face_index: HashMap<_, usize> = faces
+    // Spade numbers the outer face 0 and the inner faces from 1, in the order
+    // `inner_faces` visits them; a hash map from handle to position cost quads2000's
+    // floor (800k triangles) a second.
+    let face_index =
+        |f: spade::handles::FixedFaceHandle<spade::handles::InnerTag>| -> usize { f.index() - 1 };
+    debug_assert!(faces
         .iter()
         .enumerate()
-        .map(|(i, f)| (f.fix(), i))
-        .collect();
+        .all(|(i, f)| face_index(f.fix()) == i));
     let mut triangles: Vec<[u32; 3]> = faces
         .iter()
         .map(|f| f.vertices().map(|v| v.fix().index() as u32))
@@ -409,12 +415,13 @@ fn extract(
         };
     }
     let mut comp = vec![u32::MAX; faces.len()];
-    let mut regions: Vec<Region> = Vec::new();
+    // The largest triangle of each component, whose centre is classified.
+    let mut largest: Vec<usize> = Vec::new();
     for start in 0..faces.len() {
         if comp[start] != u32::MAX {
             continue;
         }
-        let id = regions.len() as u32;
+        let id = largest.len() as u32;
         let mut stack = vec![start];
         comp[start] = id;
         let mut best = (0.0f64, start);
@@ -428,7 +435,7 @@ fn extract(
                     continue;
                 }
                 if let Some(nb) = e.rev().face().as_inner() {
-                    let j = face_index[&nb.fix()];
+                    let j = face_index(nb.fix());
                     if comp[j] == u32::MAX {
                         comp[j] = id;
                         stack.push(j);
@@ -436,9 +443,17 @@ fn extract(
                 }
             }
         }
-        let c = faces[best.1].center();
-        regions.push(rr.classify(DVec2::new(c.x, c.y) - shift));
+        largest.push(best.1);
     }
+    // A dense receiver has hundreds of thousands of components, each classified on its own.
+    let centres: Vec<DVec2> = largest
+        .iter()
+        .map(|&t| {
+            let c = faces[t].center();
+            DVec2::new(c.x, c.y) - shift
+        })
+        .collect();
+    let regions: Vec<Region> = centres.par_iter().map(|&c| rr.classify(c)).collect();
 
     // D0 split: group the triangles around each vertex into sectors that do not cross a
     // lit|umbra edge; every sector but the first gets its own copy of the vertex.
@@ -475,7 +490,7 @@ fn extract(
         let (Some(fa), Some(fb)) = (e.face().as_inner(), e.rev().face().as_inner()) else {
             return false;
         };
-        let (ca, cb) = (comp[face_index[&fa.fix()]], comp[face_index[&fb.fix()]]);
+        let (ca, cb) = (comp[face_index(fa.fix())], comp[face_index(fb.fix())]);
         if ca == cb {
             return false;
         }
@@ -517,7 +532,7 @@ fn extract(
                 sectors.push(std::mem::take(&mut current));
             }
             match out[k].face().as_inner() {
-                Some(f) => current.push(face_index[&f.fix()]),
+                Some(f) => current.push(face_index(f.fix())),
                 // The receiver's boundary ends a sector too: on a boundary vertex the two
                 // sides of a D0 line meet again only across the outside.
                 None => {

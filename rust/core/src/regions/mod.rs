@@ -8,6 +8,7 @@ pub mod arrangement;
 pub mod relation;
 
 use glam::DVec2;
+use rayon::prelude::*;
 
 use crate::geom::box_grid::{bounds, BoxGrid};
 use crate::geom::polygon::inside_convex;
@@ -232,13 +233,21 @@ pub fn build_regions(
 
     let t2 = std::time::Instant::now();
     let classifier = Classifier::new(sh.polys, sh.inside, sh.exposure);
-    let mut faces: Vec<Region> = Vec::with_capacity(arr.faces.len());
-    for (k, f) in arr.faces.iter().enumerate() {
-        if k % 4096 == 0 {
+    // Each face on its own: a dense receiver has hundreds of thousands.
+    let faces: Vec<Region> = arr
+        .faces
+        .par_chunks(4096)
+        .map(|chunk| {
             progress.check()?;
-        }
-        faces.push(classifier.classify(f.interior));
-    }
+            Ok(chunk
+                .iter()
+                .map(|f| classifier.classify(f.interior))
+                .collect::<Vec<_>>())
+        })
+        .collect::<Result<Vec<_>, BakeError>>()?
+        .into_iter()
+        .flatten()
+        .collect();
     let t_lit = t2.elapsed().as_secs_f64();
 
     let t3 = std::time::Instant::now();

@@ -316,3 +316,83 @@ fn segment_test_is_exact_on_fan_diagonals_and_contact() {
     assert!(!hits(DVec3::ZERO, DVec3::new(0.0, 0.0, 1.0)));
     assert!(!hits(DVec3::ZERO, DVec3::new(3.0, 0.0, 2.0)));
 }
+
+/// Irradiance per unit radiance at `p` from the union of axis-aligned rectangles in the
+/// light's plane, exactly: the plane cut along every rectangle side into cells, each cell
+/// covered by some rectangle counted once by its closed form.
+fn e_union(p: DVec3, rects: &[Rect]) -> f64 {
+    let mut xs: Vec<f64> = rects.iter().flat_map(|r| [r[0], r[1]]).collect();
+    let mut ys: Vec<f64> = rects.iter().flat_map(|r| [r[2], r[3]]).collect();
+    xs.sort_by(f64::total_cmp);
+    ys.sort_by(f64::total_cmp);
+    let mut e = 0.0;
+    for x in xs.windows(2) {
+        for y in ys.windows(2) {
+            let (cx, cy) = (0.5 * (x[0] + x[1]), 0.5 * (y[0] + y[1]));
+            let covered = rects.iter().any(|r| {
+                r[0] < r[1] && r[2] < r[3] && r[0] < cx && cx < r[1] && r[2] < cy && cy < r[3]
+            });
+            if covered {
+                e += e_rect(p, [x[0], x[1], y[0], y[1]]);
+            }
+        }
+    }
+    e
+}
+
+/// Many small occluders over a floor (quads2000): their hidden parts are summed as
+/// disjoint pieces, each part minus the ones before it. Side by side at one height the
+/// parts are disjoint; at three heights they overlap; a small occluder high up hides a part
+/// nested in a lower one's. Every case is the light minus the exact union.
+#[test]
+fn many_small_occluders_hide_their_union_exactly() {
+    let square = |x: f64, y: f64, h: f64| [x - h, x + h, y - h, y + h];
+    let grid = |z: f64, shift: f64, h: f64| -> Vec<(Rect, f64)> {
+        (0..4)
+            .flat_map(|i| (0..4).map(move |j| (i, j)))
+            .map(|(i, j)| {
+                let c = |k: i32| -0.36 + 0.24 * k as f64 + shift;
+                (square(c(i), c(j), h), z)
+            })
+            .collect()
+    };
+    let disjoint = grid(1.0, 0.0, 0.05);
+    let mut overlapping = grid(1.0, 0.0, 0.05);
+    overlapping.extend(grid(0.9, 0.04, 0.05));
+    overlapping.extend(grid(1.1, -0.03, 0.06));
+    let mut nested = grid(1.0, 0.0, 0.05);
+    nested.push((square(0.12, 0.12, 0.01), 1.3));
+    for (case, occ) in [
+        ("disjoint", &disjoint),
+        ("overlapping", &overlapping),
+        ("nested", &nested),
+    ] {
+        let polys: Vec<Vec<DVec3>> = occ.iter().map(|(r, z)| rect(*r, *z, false)).collect();
+        let refs: Vec<&[DVec3]> = polys.iter().map(|v| v.as_slice()).collect();
+        for (x, y) in [(0.0, 0.0), (0.07, -0.05), (-0.31, 0.22), (0.5, 0.45)] {
+            let p = DVec3::new(x, y, 0.0);
+            let parts: Vec<Rect> = occ.iter().map(|(r, z)| hidden(p, *r, *z)).collect();
+            let want = e_rect(p, LIGHT) - e_union(p, &parts);
+            let hidden_sum: f64 = parts.iter().map(|r| e_rect(p, *r)).sum();
+            match case {
+                "overlapping" => assert!(
+                    hidden_sum > e_union(p, &parts) * (1.0 + 1e-6),
+                    "{case} at {p}: the parts do not overlap"
+                ),
+                "nested" if p == DVec3::ZERO => {
+                    let small = parts[parts.len() - 1];
+                    let inside = |r: &Rect| {
+                        r[0] < small[0] && small[1] < r[1] && r[2] < small[2] && small[3] < r[3]
+                    };
+                    assert!(parts[..parts.len() - 1].iter().any(inside), "not nested");
+                }
+                _ => {}
+            }
+            let got = eval(p, Z, Penumbra, &refs, Exact, 0);
+            assert!(
+                (got - want).abs() < 1e-12 * e_rect(p, LIGHT),
+                "{case} at {p}: {got} vs {want}"
+            );
+        }
+    }
+}

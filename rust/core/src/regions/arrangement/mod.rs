@@ -20,6 +20,7 @@
 //! Splitting is repeated until it finds nothing more, which takes a few rounds; the result
 //! then has no two edges that cross, overlap or touch except at shared end vertices.
 
+mod int_hash;
 mod interior;
 mod snap;
 mod split;

@@ -1,8 +1,8 @@
 //! Vertices with snapping: a point within `snap` of an existing vertex is that vertex.
 
-use std::collections::HashMap;
-
 use glam::DVec2;
+
+use super::int_hash::IntMap;
 
 pub(super) struct VertexPool {
     pts: Vec<DVec2>,
@@ -10,8 +10,13 @@ pub(super) struct VertexPool {
     /// Hash-grid cell side; at least `snap`, so the 3×3 cells around a point hold every
     /// vertex within `snap` of it.
     cell: f64,
-    grid: HashMap<(i64, i64), Vec<u32>>,
+    /// First and last vertex of each non-empty cell; `next` links a cell's vertices in the
+    /// order they came (one allocation per cell cost more than the search).
+    grid: IntMap<(i64, i64), (u32, u32)>,
+    next: Vec<u32>,
 }
+
+const END: u32 = u32::MAX;
 
 impl VertexPool {
     /// `extent`: the largest coordinate magnitude expected; it bounds the cell side from
@@ -24,7 +29,8 @@ impl VertexPool {
             pts: Vec::new(),
             snap,
             cell,
-            grid: HashMap::new(),
+            grid: IntMap::default(),
+            next: Vec::new(),
         }
     }
 
@@ -52,11 +58,13 @@ impl VertexPool {
         for di in -1..=1i64 {
             for dj in -1..=1i64 {
                 let k = (i.saturating_add(di), j.saturating_add(dj));
-                for &v in self.grid.get(&k).into_iter().flatten() {
+                let mut v = self.grid.get(&k).map_or(END, |c| c.0);
+                while v != END {
                     let d = (self.pts[v as usize] - p).length();
                     if d <= self.snap && best.is_none_or(|(bd, _)| d < bd) {
                         best = Some((d, v));
                     }
+                    v = self.next[v as usize];
                 }
             }
         }
@@ -65,7 +73,16 @@ impl VertexPool {
         }
         let v = self.pts.len() as u32;
         self.pts.push(p);
-        self.grid.entry((i, j)).or_default().push(v);
+        self.next.push(END);
+        match self.grid.get_mut(&(i, j)) {
+            Some(cell) => {
+                self.next[cell.1 as usize] = v;
+                cell.1 = v;
+            }
+            None => {
+                self.grid.insert((i, j), (v, v));
+            }
+        }
         v
     }
 }

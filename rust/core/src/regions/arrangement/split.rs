@@ -5,10 +5,10 @@
 //! through), so edges far apart are never compared: near-linear for the usual receiver with
 //! hundreds of short, mostly disjoint shadow edges, instead of the paper's all-pairs T_idd.
 
-use std::collections::HashMap;
-
 use glam::DVec2;
+use rayon::prelude::*;
 
+use super::int_hash::IntMap;
 use super::snap::VertexPool;
 use super::CHECK_EVERY;
 use crate::geom::polygon::orient;
@@ -59,18 +59,23 @@ pub(super) fn split_all(
             splits: vec![Vec::new(); edges.len()],
             merges: Vec::new(),
         };
-        for (k, (i, j)) in pairs.into_iter().enumerate() {
-            if k % CHECK_EVERY == 0 {
+        // The pair tests read only the edges and the vertices made before this round, so
+        // they run in parallel; what they find is applied in pair order, crossing points
+        // inserted into the pool in that order too, so the result does not depend on the
+        // number of threads.
+        let pts = pool.points();
+        let outcomes: Vec<Vec<Outcome>> = pairs
+            .par_chunks(CHECK_EVERY)
+            .map(|chunk| {
                 progress.check()?;
-            }
-            intersect_pair(
-                pool,
-                &alias,
-                &edges,
-                (i as usize, j as usize),
-                snap,
-                &mut found,
-            );
+                Ok(chunk
+                    .iter()
+                    .filter_map(|&(i, j)| test_pair(pts, &edges, (i as usize, j as usize), snap))
+                    .collect())
+            })
+            .collect::<Result<_, BakeError>>()?;
+        for o in outcomes.into_iter().flatten() {
+            apply_outcome(pool, &alias, &edges, o, &mut found);
         }
         if !found.merges.is_empty() {
             // Splits found this round may name merged vertices; the next round finds them
@@ -107,7 +112,8 @@ struct Found {
 
 /// One edge per vertex pair, carrying the tags of everything that landed on it.
 fn merge(edges: Vec<Edge>) -> Vec<Edge> {
-    let mut index: HashMap<(u32, u32), usize> = HashMap::with_capacity(edges.len());
+    let mut index: IntMap<(u32, u32), usize> =
+        IntMap::with_capacity_and_hasher(edges.len(), Default::default());
     let mut out: Vec<Edge> = Vec::with_capacity(edges.len());
     for e in edges {
         let [a, b] = e.v;
@@ -176,7 +182,7 @@ pub(super) fn candidate_pairs(pts: &[DVec2], edges: &[Edge], snap: f64) -> Vec<(
             }
         }
     }
-    cells.sort_unstable();
+    cells.par_sort_unstable();
     let mut pairs = Vec::new();
     let mut start = 0;
     while start < cells.len() {
@@ -191,21 +197,20 @@ pub(super) fn candidate_pairs(pts: &[DVec2], edges: &[Edge], snap: f64) -> Vec<(
         }
         start = end;
     }
-    pairs.sort_unstable();
+    pairs.par_sort_unstable();
     pairs.dedup();
     pairs
 }
 
-/// Records where edges `i` and `j` must be split, or which vertices must merge, so that they
-/// meet only at end vertices.
-fn intersect_pair(
-    pool: &mut VertexPool,
-    alias: &UnionFind,
-    edges: &[Edge],
-    (i, j): (usize, usize),
-    snap: f64,
-    found: &mut Found,
-) {
+/// What the test of one pair of edges found: touches (a vertex of one on the other),
+/// or else a proper crossing, not yet a vertex.
+enum Outcome {
+    Touches(Vec<(Touch, u32, usize)>),
+    Crossing { i: usize, j: usize, at: DVec2 },
+}
+
+/// How edges `i` and `j` meet, if they meet other than at a shared end vertex.
+fn test_pair(pts: &[DVec2], edges: &[Edge], (i, j): (usize, usize), snap: f64) -> Option<Outcome> {
     let [a, b] = edges[i].v;
     let [c, d] = edges[j].v;
     // An end vertex of one lying on (or within `snap` of) the other's interior splits it:
@@ -214,7 +219,7 @@ fn intersect_pair(
     // they share it. Computing the crossing as well would give a second, ill-conditioned
     // point when they are nearly collinear, and the two points would keep splitting the
     // pieces round after round.
-    let mut touched = false;
+    let mut touches = Vec::new();
     for (p, (u, w), target) in [
         (c, (a, b), i),
         (d, (a, b), i),
@@ -224,17 +229,17 @@ fn intersect_pair(
         if p == u || p == w {
             continue;
         }
-        match touch(pool.points(), u, w, p, snap) {
+        match touch(pts, u, w, p, snap) {
             Touch::Apart => continue,
-            Touch::Split => found.splits[target].push(p),
-            Touch::Merge(q) => found.merges.push((p, q)),
+            t => touches.push((t, p, target)),
         }
-        touched = true;
     }
-    if touched || a == c || a == d || b == c || b == d {
-        return;
+    if !touches.is_empty() {
+        return Some(Outcome::Touches(touches));
     }
-    let pts = pool.points();
+    if a == c || a == d || b == c || b == d {
+        return None;
+    }
     let (pa, pb, pc, pd) = (
         pts[a as usize],
         pts[b as usize],
@@ -245,17 +250,46 @@ fn intersect_pair(
     let (o3, o4) = (orient(pc, pd, pa), orient(pc, pd, pb));
     let proper = opposite(o1, o2) && opposite(o3, o4);
     if !proper {
-        return;
+        return None;
     }
     // o3, o4 are twice the signed areas of c-d-a and c-d-b, so they weigh the split of a→b.
     let t = (o3 / (o3 - o4)).clamp(0.0, 1.0);
-    let x = pa + (pb - pa) * t;
-    let v = alias.root(pool.insert(x));
-    if v != a && v != b {
-        found.splits[i].push(v);
-    }
-    if v != c && v != d {
-        found.splits[j].push(v);
+    Some(Outcome::Crossing {
+        i,
+        j,
+        at: pa + (pb - pa) * t,
+    })
+}
+
+/// Records where edges must be split, or which vertices must merge, so that a pair meets
+/// only at end vertices.
+fn apply_outcome(
+    pool: &mut VertexPool,
+    alias: &UnionFind,
+    edges: &[Edge],
+    outcome: Outcome,
+    found: &mut Found,
+) {
+    match outcome {
+        Outcome::Touches(touches) => {
+            for (t, p, target) in touches {
+                match t {
+                    Touch::Apart => {}
+                    Touch::Split => found.splits[target].push(p),
+                    Touch::Merge(q) => found.merges.push((p, q)),
+                }
+            }
+        }
+        Outcome::Crossing { i, j, at } => {
+            let ([a, b], [c, d]) = (edges[i].v, edges[j].v);
+            let v = alias.root(pool.insert(at));
+            if v != a && v != b {
+                found.splits[i].push(v);
+            }
+            if v != c && v != d {
+                found.splits[j].push(v);
+            }
+        }
     }
 }
 

@@ -7,6 +7,7 @@
 use std::cmp::Ordering;
 
 use glam::DVec2;
+use rayon::prelude::*;
 
 use super::{interior, winding, ArrEdge, ArrFace, CHECK_EVERY};
 use crate::geom::polygon::orient;
@@ -136,11 +137,8 @@ pub(super) fn faces(
         }
     }
 
-    let mut out = Vec::with_capacity(outer.len());
-    for (oi, &ol) in outer.iter().enumerate() {
-        if oi % CHECK_EVERY == 0 {
-            progress.check()?;
-        }
+    // Faces are built independently: in parallel, in order.
+    let face = |(oi, &ol): (usize, &usize)| -> ArrFace {
         let o = &loops[ol];
         let mut area = o.area;
         let mut holes = Vec::new();
@@ -157,15 +155,27 @@ pub(super) fn faces(
         }
         boundary_edges.sort_unstable();
         boundary_edges.dedup();
-        out.push(ArrFace {
+        ArrFace {
             outer: o.reduced.iter().map(|&h| origin(edges, h)).collect(),
             holes,
             interior: interior::point(pts, &walk),
             area,
             boundary_edges,
-        });
-    }
-    Ok(out)
+        }
+    };
+    let chunks: Vec<Vec<ArrFace>> = outer
+        .par_chunks(CHECK_EVERY)
+        .enumerate()
+        .map(|(c, chunk)| {
+            progress.check()?;
+            Ok(chunk
+                .iter()
+                .enumerate()
+                .map(|(k, ol)| face((c * CHECK_EVERY + k, ol)))
+                .collect())
+        })
+        .collect::<Result<_, BakeError>>()?;
+    Ok(chunks.into_iter().flatten().collect())
 }
 
 #[inline]
