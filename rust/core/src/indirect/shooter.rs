@@ -46,6 +46,8 @@ pub(super) struct Shooter<'a> {
     pub(super) face_blockers: Vec<OnceLock<Option<Vec<Reached>>>>,
     /// The backs of thin faces that receive.
     pub(super) backs: super::back::Backs,
+    /// `face_blockers` for back receivers, same keys (`back::BackReach`).
+    pub(super) back_blockers: Vec<OnceLock<Option<super::back::BackReach>>>,
     pub(super) kept: AtomicUsize,
     /// Per patch, after its first shot: the faces it reached and each of their vertices'
     /// form factor times visibility. A patch shoots again whenever light came back to it
@@ -203,6 +205,7 @@ impl<'a> Shooter<'a> {
             tol,
             face_blockers: (0..2 * nf).map(|_| OnceLock::new()).collect(),
             backs: super::back::Backs::new(patches),
+            back_blockers: (0..2 * nf).map(|_| OnceLock::new()).collect(),
             kept: AtomicUsize::new(0),
             factors: (0..patches.len()).map(|_| OnceLock::new()).collect(),
             factors_kept: AtomicUsize::new(0),
