@@ -22,7 +22,7 @@ use std::sync::atomic::Ordering;
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::pair::{Blockers, FaceBlockers, Reached};
+use super::pair::{Blockers, FaceBlockers, Pair, Reached};
 use super::patches::{patch, Grid, Patch};
 use super::shooter::{Group, Shooter};
 use super::{FACE_OCCLUDER_BUDGET, FEW_RAYS_BELOW, MAX_FACE_OCCLUDERS, ONE_RAY_BELOW};
@@ -222,6 +222,14 @@ impl Shooter<'_> {
         cell.as_ref()
     }
 
+    /// Whether `patch` is seen from every point of `group`'s box by one ray
+    /// (`receive_at`), with something possibly in the way: then a ray through the BVH per
+    /// point costs less than the box query that would look for what it might cross.
+    pub(super) fn one_ray(&self, patch: &Patch, pair: &Pair, group: &Group) -> bool {
+        let nearest = patch.centroid.clamp(group.lo, group.hi);
+        pair.known.is_some() && patch.radius < ONE_RAY_BELOW * (patch.centroid - nearest).length()
+    }
+
     /// How many patches face `f` has on its back (if `back`) or front.
     pub(super) fn side_patches(&self, f: u32, back: bool) -> usize {
         if !back {
@@ -274,11 +282,7 @@ impl Shooter<'_> {
                     // One point that will see the shooter by one ray (`receive_at`): a
                     // ray through the BVH costs less than the box query that would look
                     // for what it might cross.
-                    let one_ray = points.len() == 1 && {
-                        let x = points[0];
-                        patch.radius / (patch.centroid - x).length() < ONE_RAY_BELOW
-                    };
-                    let blockers = if one_ray && pair.known.is_some() {
+                    let blockers = if points.len() == 1 && self.one_ray(patch, &pair, &group) {
                         Blockers::Any
                     } else {
                         self.blockers(patch.face, &patch.poly, &plane, &pair, &group)

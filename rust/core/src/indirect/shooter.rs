@@ -16,6 +16,10 @@ use crate::indirect::patches::Patch;
 use crate::mesh::elements::Elements;
 use crate::scene::Scene;
 
+/// Vertex groups of at most this many vertices, each seeing the shooter by one ray, cast
+/// their rays through the BVH instead of first asking it for what could block them.
+const ONE_RAY_GROUP: usize = 8;
+
 /// What a shot needs about the scene, built once.
 pub(super) struct Shooter<'a> {
     pub(super) scene: &'a Scene,
@@ -260,7 +264,13 @@ impl<'a> Shooter<'a> {
                 let pair = &pairs[k];
                 let mut out = Vec::new();
                 for group in &self.groups[g0..g1] {
-                    let blockers = self.blockers(patch.face, &patch.poly, &plane, pair, group);
+                    // A few vertices, one ray each: rays beat the box query (`one_ray`).
+                    let few = (group.end - group.start) as usize <= ONE_RAY_GROUP;
+                    let blockers = if few && self.one_ray(patch, pair, group) {
+                        Blockers::Any
+                    } else {
+                        self.blockers(patch.face, &patch.poly, &plane, pair, group)
+                    };
                     if self.fit && matches!(blockers, Blockers::None) {
                         if let Some(vals) = self.fitted(patch, &plane, pair, group) {
                             out.extend(vals);
