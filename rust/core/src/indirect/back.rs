@@ -17,12 +17,15 @@
 //! (`direct::back`), and what the shots send to about four of them, or its centroid when
 //! it is small seen from the shooter (`back_gains`).
 
+use std::sync::atomic::Ordering;
+
 use glam::DVec3;
 use rayon::prelude::*;
 
+use super::pair::{Blockers, FaceBlockers, Pair, Reached};
 use super::patches::{patch, Grid, Patch};
 use super::shooter::{Group, Shooter};
-use super::FEW_RAYS_BELOW;
+use super::{FACE_OCCLUDER_BUDGET, FEW_RAYS_BELOW, MAX_FACE_OCCLUDERS, ONE_RAY_BELOW};
 use crate::geom::bvh::{Aabb, BoxTree};
 use crate::geom::polygon::{signed_area_2d, simplify_convex};
 use crate::geom::raycast::Occluders;
@@ -149,18 +152,116 @@ pub(super) fn back_direct(
         .collect())
 }
 
+/// Per shooter face and side: the back receivers its light can reach (index into
+/// `Backs::faces`), and of those the ones something could stand in front of, with what (for
+/// the whole shooter face; each patch narrows it down), as `face_blockers` keeps for fronts.
+pub(super) struct BackReach {
+    reach: Vec<u32>,
+    blockers: Vec<Reached>,
+}
+
 impl Shooter<'_> {
+    /// The back receivers of shots from face `fp` (from its back if `back`): `None` over the
+    /// memory budget, then every back is tried and each patch asks the BVH.
+    fn back_reach(&self, fp: u32, back: bool) -> Option<&BackReach> {
+        let nf = self.scene.faces.len();
+        let cell = self.back_blockers[fp as usize + back as usize * nf].get_or_init(|| {
+            if self.kept.load(Ordering::Relaxed) > FACE_OCCLUDER_BUDGET {
+                return None;
+            }
+            let face = &self.scene.faces[fp as usize];
+            let plane = if back {
+                face.plane.flipped()
+            } else {
+                face.plane
+            };
+            let single = self.side_patches(fp, back) == 1;
+            let found: Vec<(u32, Option<FaceBlockers>)> = self
+                .backs
+                .faces
+                .par_iter()
+                .enumerate()
+                .filter_map(|(k, &(g, start, end))| {
+                    let side = self.scene.faces[g as usize].plane.flipped();
+                    let (lo, hi) = self.shaft(&face.verts, fp, &plane, g, &side)?;
+                    // One patch to one patch: the query for the pair's own box is the
+                    // same work, narrower; a face-wide list would only add to it.
+                    if single && end - start == 1 {
+                        return Some((k as u32, Some(FaceBlockers::Many)));
+                    }
+                    let mut list = Vec::new();
+                    self.occ
+                        .candidates(lo, hi, &[plane, side], &[fp, g], &mut list);
+                    let blockers = match list.len() {
+                        0 => None,
+                        n if n <= MAX_FACE_OCCLUDERS => Some(FaceBlockers::Listed(list)),
+                        _ => Some(FaceBlockers::Many),
+                    };
+                    Some((k as u32, blockers))
+                })
+                .collect();
+            let mut reach = Vec::with_capacity(found.len());
+            let mut blockers = Vec::new();
+            for (k, b) in found {
+                reach.push(k);
+                if let Some(b) = b {
+                    blockers.push((self.backs.faces[k as usize].0, b));
+                }
+            }
+            let size = reach.len()
+                + blockers
+                    .iter()
+                    .map(|(_, b)| match b {
+                        FaceBlockers::Listed(l) => 1 + l.len(),
+                        FaceBlockers::Many => 1,
+                    })
+                    .sum::<usize>();
+            self.kept.fetch_add(size, Ordering::Relaxed);
+            Some(BackReach { reach, blockers })
+        });
+        cell.as_ref()
+    }
+
+    /// Whether `patch` is seen from every point of `group`'s box by one ray
+    /// (`receive_at`), with something possibly in the way: then a ray through the BVH per
+    /// point costs less than the box query that would look for what it might cross.
+    pub(super) fn one_ray(&self, patch: &Patch, pair: &Pair, group: &Group) -> bool {
+        let nearest = patch.centroid.clamp(group.lo, group.hi);
+        pair.known.is_some() && patch.radius < ONE_RAY_BELOW * (patch.centroid - nearest).length()
+    }
+
+    /// How many patches face `f` has on its back (if `back`) or front.
+    pub(super) fn side_patches(&self, f: u32, back: bool) -> usize {
+        if !back {
+            return self.patches_of(f).len();
+        }
+        let faces = &self.backs.faces;
+        match faces.binary_search_by_key(&f, |e| e.0) {
+            Ok(i) => (faces[i].2 - faces[i].1) as usize,
+            Err(_) => 0,
+        }
+    }
+
     /// What each back patch gains per unit of radiosity shot by `patch`: the mean over its
     /// points of form factor times visibility; `b` only decides how hard to look. Patches
     /// that gain nothing are left out.
     pub(super) fn back_gains(&self, patch: &Patch, b: DVec3) -> Vec<(u32, f64)> {
         let plane = patch.plane;
-        self.backs
-            .faces
+        let reach = self.back_reach(patch.face, patch.back);
+        let all: Vec<u32>;
+        let (faces, known) = match reach {
+            Some(r) => (&r.reach[..], Some(&r.blockers[..])),
+            None => {
+                all = (0..self.backs.faces.len() as u32).collect();
+                (&all[..], None)
+            }
+        };
+        faces
             .par_iter()
-            .flat_map_iter(|&(g, start, end)| {
+            .flat_map_iter(|&k| {
+                let (g, start, end) = self.backs.faces[k as usize];
                 let side = self.scene.faces[g as usize].plane.flipped();
-                let pair = self.pair_on(&patch.poly, patch.face, &plane, g, side, None);
+                let pair = self.pair_on(&patch.poly, patch.face, &plane, g, side, known);
                 let mut out = Vec::new();
                 let Some(pair) = pair else { return out };
                 for q in start..end {
@@ -178,7 +279,14 @@ impl Shooter<'_> {
                         lo,
                         hi,
                     };
-                    let blockers = self.blockers(patch.face, &patch.poly, &plane, &pair, &group);
+                    // One point that will see the shooter by one ray (`receive_at`): a
+                    // ray through the BVH costs less than the box query that would look
+                    // for what it might cross.
+                    let blockers = if points.len() == 1 && self.one_ray(patch, &pair, &group) {
+                        Blockers::Any
+                    } else {
+                        self.blockers(patch.face, &patch.poly, &plane, &pair, &group)
+                    };
                     let sum: f64 = points
                         .iter()
                         .map(|&x| self.receive_at(patch, &plane, &pair, &blockers, x, side.n, b))

@@ -28,12 +28,18 @@ impl Shooter<'_> {
             } else {
                 face.plane
             };
+            let single = self.side_patches(fp, back) == 1;
             let found: Vec<Reached> = self
                 .receivers
                 .par_iter()
                 .filter_map(|&f| {
                     let front = self.scene.faces[f as usize].plane;
                     let (lo, hi) = self.shaft(&face.verts, fp, &plane, f, &front)?;
+                    // One patch to one vertex group: the group's own query does it.
+                    let groups = self.group_start[f as usize + 1] - self.group_start[f as usize];
+                    if single && groups == 1 {
+                        return Some((f, FaceBlockers::Many));
+                    }
                     let mut list = Vec::new();
                     let planes = [plane, front];
                     self.occ.candidates(lo, hi, &planes, &[fp, f], &mut list);
@@ -105,7 +111,7 @@ impl Shooter<'_> {
     }
 
     /// `pair` for the side of face `f` whose plane is `side` (for its back, the face's plane
-    /// turned round; `known` then `None`, as lists are kept for fronts only).
+    /// turned round, with `known` from `back_reach` for backs).
     pub(super) fn pair_on<'s>(
         &self,
         poly: &[DVec3],

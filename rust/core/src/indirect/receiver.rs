@@ -34,7 +34,11 @@ impl Shooter<'_> {
             let Some(pair) = self.pair(&patch.poly, patch.face, &plane, f, known) else {
                 continue;
             };
-            let blockers = self.blockers(patch.face, &patch.poly, &plane, &pair, &group);
+            let blockers = if self.one_ray(patch, &pair, &group) {
+                Blockers::Any
+            } else {
+                self.blockers(patch.face, &patch.poly, &plane, &pair, &group)
+            };
             sum += b * self.receive(patch, &plane, &pair, &blockers, v, b);
         }
         sum

@@ -16,6 +16,10 @@ use crate::indirect::patches::Patch;
 use crate::mesh::elements::Elements;
 use crate::scene::Scene;
 
+/// Vertex groups of at most this many vertices, each seeing the shooter by one ray, cast
+/// their rays through the BVH instead of first asking it for what could block them.
+const ONE_RAY_GROUP: usize = 8;
+
 /// What a shot needs about the scene, built once.
 pub(super) struct Shooter<'a> {
     pub(super) scene: &'a Scene,
@@ -46,6 +50,8 @@ pub(super) struct Shooter<'a> {
     pub(super) face_blockers: Vec<OnceLock<Option<Vec<Reached>>>>,
     /// The backs of thin faces that receive.
     pub(super) backs: super::back::Backs,
+    /// `face_blockers` for back receivers, same keys (`back::BackReach`).
+    pub(super) back_blockers: Vec<OnceLock<Option<super::back::BackReach>>>,
     pub(super) kept: AtomicUsize,
     /// Per patch, after its first shot: the faces it reached and each of their vertices'
     /// form factor times visibility. A patch shoots again whenever light came back to it
@@ -203,6 +209,7 @@ impl<'a> Shooter<'a> {
             tol,
             face_blockers: (0..2 * nf).map(|_| OnceLock::new()).collect(),
             backs: super::back::Backs::new(patches),
+            back_blockers: (0..2 * nf).map(|_| OnceLock::new()).collect(),
             kept: AtomicUsize::new(0),
             factors: (0..patches.len()).map(|_| OnceLock::new()).collect(),
             factors_kept: AtomicUsize::new(0),
@@ -257,7 +264,13 @@ impl<'a> Shooter<'a> {
                 let pair = &pairs[k];
                 let mut out = Vec::new();
                 for group in &self.groups[g0..g1] {
-                    let blockers = self.blockers(patch.face, &patch.poly, &plane, pair, group);
+                    // A few vertices, one ray each: rays beat the box query (`one_ray`).
+                    let few = (group.end - group.start) as usize <= ONE_RAY_GROUP;
+                    let blockers = if few && self.one_ray(patch, pair, group) {
+                        Blockers::Any
+                    } else {
+                        self.blockers(patch.face, &patch.poly, &plane, pair, group)
+                    };
                     if self.fit && matches!(blockers, Blockers::None) {
                         if let Some(vals) = self.fitted(patch, &plane, pair, group) {
                             out.extend(vals);
