@@ -33,6 +33,29 @@ fn disk(n: usize, r: f64, z: f64) -> Vec<[f64; 3]> {
         .collect()
 }
 
+/// The exact light (red channel) of the `light` polygon at the floor point `p` (facing up),
+/// for the relation `rel` and the `blockers` between them.
+fn floor_light(
+    p: DVec3,
+    light: &[DVec3],
+    plane: &Plane,
+    rel: Relation,
+    blockers: &[&[DVec3]],
+) -> f64 {
+    exact_area_light(
+        p,
+        DVec3::Z,
+        light,
+        plane,
+        DVec3::ONE,
+        rel,
+        blockers,
+        PenumbraVisibility::Exact,
+        0,
+    )
+    .x
+}
+
 /// A 400-gon disk over a floor: its shadow is that of its simplified outline
 /// (`geom::simplify`, within 1e-3 of its size), both in the mesh and in the light. At every
 /// floor vertex the baked light differs from the exact one (the exact 400-gon subtracted from
@@ -60,20 +83,7 @@ fn a_many_edged_occluder_changes_the_light_by_less_than_its_simplification_band(
     let (mut worst, mut penumbra) = (0.0f64, 0);
     for (p, c) in floor.positions.iter().zip(&floor.colors) {
         let p = DVec3::from(*p);
-        let e = |rel, blockers: &[&[DVec3]]| {
-            exact_area_light(
-                p,
-                DVec3::Z,
-                &light,
-                &plane,
-                DVec3::ONE,
-                rel,
-                blockers,
-                PenumbraVisibility::Exact,
-                0,
-            )
-            .x
-        };
+        let e = |rel, blockers: &[&[DVec3]]| floor_light(p, &light, &plane, rel, blockers);
         let full = e(Relation::Lit, &[]);
         let want = e(Relation::Penumbra, &[&occ]);
         if want > 1e-3 * full && want < (1.0 - 1e-3) * full {
@@ -183,20 +193,8 @@ fn the_floor_under_many_shadows_follows_the_exact_light() {
         .map(|q| q.iter().map(|v| DVec3::from(*v)).collect())
         .collect();
     let blockers: Vec<&[DVec3]> = occ.iter().map(|v| v.as_slice()).collect();
-    let exact = |p: DVec3, rel, blockers: &[&[DVec3]]| {
-        exact_area_light(
-            p,
-            DVec3::Z,
-            &light,
-            &plane,
-            DVec3::ONE,
-            rel,
-            blockers,
-            PenumbraVisibility::Exact,
-            0,
-        )
-        .x
-    };
+    let exact =
+        |p: DVec3, rel, blockers: &[&[DVec3]]| floor_light(p, &light, &plane, rel, blockers);
     let full = exact(DVec3::ZERO, Relation::Lit, &[]);
     // Triangles by the cells of a 200 × 200 grid over the floor.
     let pos: Vec<DVec2> = floor

@@ -170,11 +170,7 @@ impl Shooter<'_> {
                 return None;
             }
             let face = &self.scene.faces[fp as usize];
-            let plane = if back {
-                face.plane.flipped()
-            } else {
-                face.plane
-            };
+            let plane = self.side_plane(fp, back);
             let single = self.side_patches(fp, back) == 1;
             let found: Vec<(u32, Option<FaceBlockers>)> = self
                 .backs

@@ -14,6 +14,16 @@ use crate::geom::polygon::clip_polygon_3d;
 use crate::geom::Plane;
 
 impl Shooter<'_> {
+    /// The plane of face `fp` as seen from the side it shoots from (its back if `back`).
+    pub(super) fn side_plane(&self, fp: u32, back: bool) -> Plane {
+        let plane = self.scene.faces[fp as usize].plane;
+        if back {
+            plane.flipped()
+        } else {
+            plane
+        }
+    }
+
     /// The receivers of shots from face `fp` (from its back if `back`) that something could
     /// stand in front of.
     pub(super) fn face_blockers(&self, fp: u32, back: bool) -> Option<&[Reached]> {
@@ -23,11 +33,7 @@ impl Shooter<'_> {
                 return None;
             }
             let face = &self.scene.faces[fp as usize];
-            let plane = if back {
-                face.plane.flipped()
-            } else {
-                face.plane
-            };
+            let plane = self.side_plane(fp, back);
             let single = self.side_patches(fp, back) == 1;
             let found: Vec<Reached> = self
                 .receivers
