@@ -90,26 +90,11 @@ impl BoxTree {
 
     /// Items whose box may touch the convex volume given by `planes` (all `dist >= 0`).
     pub fn query_volume(&self, planes: &[Plane], eps: f64, out: &mut Vec<u32>) {
-        if self.nodes.is_empty() {
-            return;
-        }
-        let mut stack = vec![0usize];
-        while let Some(i) = stack.pop() {
-            let n = &self.nodes[i];
-            if !n.bounds.may_touch(planes, eps) {
-                continue;
-            }
-            if n.count > 0 {
-                for &it in &self.items[n.start as usize..(n.start + n.count) as usize] {
-                    if self.boxes[it as usize].may_touch(planes, eps) {
-                        out.push(it);
-                    }
-                }
-            } else {
-                stack.push(n.start as usize);
-                stack.push(n.start as usize + 1);
-            }
-        }
+        // The same walk as `any_in_volume`, never stopping early.
+        self.any_in_volume(planes, eps, |it| {
+            out.push(it);
+            false
+        });
     }
 
     /// Whether `keep` holds for some item whose box may touch the convex volume given by

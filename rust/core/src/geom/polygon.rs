@@ -18,6 +18,19 @@ pub fn clip_polygon_3d(poly: &[DVec3], plane: &Plane, eps: f64) -> Vec<DVec3> {
 /// [`clip_polygon_3d`] into `out` (cleared first). It allocates nothing when `out` has room,
 /// which matters to the direct stage: it clips a light polygon tens of millions of times.
 pub fn clip_polygon_3d_into(poly: &[DVec3], plane: &Plane, eps: f64, out: &mut Vec<DVec3>) {
+    clip_by(poly, |p| plane.dist(p), eps, out);
+}
+
+/// Sutherland–Hodgman against one side: keeps the part of convex `poly` where `dist` ≥ 0,
+/// vertices within `eps` counting as on the boundary. Generic over the point type so that
+/// the 2-D and 3-D clips are one loop (monomorphised: no cost on the direct stage's path).
+fn clip_by<T>(poly: &[T], dist: impl Fn(T) -> f64, eps: f64, out: &mut Vec<T>)
+where
+    T: Copy
+        + std::ops::Add<Output = T>
+        + std::ops::Sub<Output = T>
+        + std::ops::Mul<f64, Output = T>,
+{
     out.clear();
     let n = poly.len();
     if n == 0 {
@@ -25,7 +38,7 @@ pub fn clip_polygon_3d_into(poly: &[DVec3], plane: &Plane, eps: f64, out: &mut V
     }
     let (mut keep_all, mut drop_all) = (true, true);
     for p in poly {
-        let d = plane.dist(*p);
+        let d = dist(*p);
         keep_all &= d >= -eps;
         drop_all &= d <= eps;
     }
@@ -36,11 +49,11 @@ pub fn clip_polygon_3d_into(poly: &[DVec3], plane: &Plane, eps: f64, out: &mut V
     if drop_all {
         return;
     }
-    let mut da = plane.dist(poly[0]);
+    let mut da = dist(poly[0]);
     for i in 0..n {
         let j = (i + 1) % n;
         let (a, b) = (poly[i], poly[j]);
-        let db = plane.dist(b);
+        let db = dist(b);
         if da >= -eps {
             out.push(a);
         }
@@ -76,40 +89,8 @@ pub fn clip_polygon_2d(poly: &[DVec2], h: &HalfPlane, eps: f64) -> Vec<DVec2> {
 
 /// [`clip_polygon_2d`] into `out` (cleared first), allocating nothing when `out` has room.
 pub fn clip_polygon_2d_into(poly: &[DVec2], h: &HalfPlane, eps: f64, out: &mut Vec<DVec2>) {
-    out.clear();
-    let n = poly.len();
-    if n == 0 {
-        return;
-    }
     let inv = 1.0 / h.n.length();
-    let dist = |p: DVec2| h.eval(p) * inv;
-    let (mut keep_all, mut drop_all) = (true, true);
-    for p in poly {
-        let d = dist(*p);
-        keep_all &= d >= -eps;
-        drop_all &= d <= eps;
-    }
-    if keep_all {
-        out.extend_from_slice(poly);
-        return;
-    }
-    if drop_all {
-        return;
-    }
-    let mut da = dist(poly[0]);
-    for i in 0..n {
-        let j = (i + 1) % n;
-        let (a, b) = (poly[i], poly[j]);
-        let db = dist(b);
-        if da >= -eps {
-            out.push(a);
-        }
-        if (da > eps && db < -eps) || (da < -eps && db > eps) {
-            let t = da / (da - db);
-            out.push(a + (b - a) * t);
-        }
-        da = db;
-    }
+    clip_by(poly, |p| h.eval(p) * inv, eps, out);
 }
 
 /// Convex counter-clockwise `piece` minus convex counter-clockwise `c`, as disjoint convex
