@@ -29,6 +29,7 @@ mod blockers;
 pub(crate) mod coplanar_contacts;
 mod fit;
 mod gather;
+pub mod hierarchical;
 mod mls;
 mod pair;
 pub(crate) mod patches;
@@ -49,6 +50,7 @@ use crate::geom::raycast::Occluders;
 use crate::indirect::patches::{build_patches, Patch};
 use crate::mesh::elements::Elements;
 use crate::progress::Progress;
+use crate::scene::settings::IndirectSolver;
 use crate::scene::Scene;
 use crate::BakeError;
 
@@ -62,8 +64,16 @@ pub struct IndirectResult {
     pub gather_vertices: u64,
     pub shots: u64,
     /// Unshot power left at the end over the power emitted (reflected direct light plus
-    /// emission), before any ambient term.
+    /// emission), before any ambient term. For the hierarchical solver, the power the last
+    /// sweep added, over the power emitted.
     pub unshot_fraction: f64,
+    /// Hierarchical solver only: links after refinement, leaves (element triangles not
+    /// under a cover), visibility rays cast while refining, and memory of the hierarchy and
+    /// links per leaf in bytes.
+    pub links: u64,
+    pub leaves: u64,
+    pub rays: u64,
+    pub bytes_per_leaf: f64,
 }
 
 /// Patches whose apparent size (radius over distance) falls under these use 1 or ~4 rays
@@ -98,6 +108,9 @@ pub fn indirect(
     occ: &Occluders,
     progress: &Progress,
 ) -> Result<IndirectResult, BakeError> {
+    if scene.settings.indirect_solver == IndirectSolver::Hierarchical {
+        return hierarchical::indirect(scene, el, direct, occ, progress);
+    }
     let spacing = GATHER_SPACING * scene.settings.element_size;
     indirect_at(scene, el, direct, occ, progress, spacing)
 }
