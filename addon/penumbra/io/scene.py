@@ -66,6 +66,7 @@ def settings_dict(settings, meshes, lights):
         "penumbra_element_size": float(min(penumbra, element)),
         "indirect": bool(settings.use_indirect),
         "convergence": float(settings.convergence),
+        "indirect_solver": str(settings.indirect_solver).lower(),
         "lighting_only": bool(settings.lighting_only),
     }
     # 0 leaves the core's default (half of the machine's memory).

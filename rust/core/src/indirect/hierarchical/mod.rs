@@ -46,7 +46,6 @@ use crate::BakeError;
 
 use super::IndirectResult;
 
-
 /// Refinement tolerance: a link may carry up to this times `convergence` of the emitted power.
 const EPS_SCALE: f64 = 1.0;
 /// The solve ends when a sweep adds less than this times `convergence` of the emitted power.
@@ -285,4 +284,3 @@ fn ambient(h: &Hierarchy, leaves: &Leaves, delta: DVec3) -> DVec3 {
 
 #[cfg(test)]
 pub(crate) mod test;
-
