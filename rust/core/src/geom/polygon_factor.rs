@@ -149,30 +149,41 @@ fn centroid(p: &[DVec3]) -> DVec3 {
 
 /// `Σ_i Σ_j (e_i · e_j) ∫∫ ln |x − y|` over the edges of two closed contours.
 fn contour_sum(a: &[DVec3], b: &[DVec3]) -> f64 {
-    let extent = |p: &[DVec3]| {
-        let c = centroid(p);
+    let loop_edges = |p: &[DVec3]| -> Vec<[DVec3; 2]> {
+        (0..p.len()).map(|i| [p[i], p[(i + 1) % p.len()]]).collect()
+    };
+    edges_sum(&loop_edges(a), &loop_edges(b))
+}
+
+/// [`contour_sum`] for two regions given as directed boundary edges in any order (the sum
+/// is additive over edges, so loops need not be traced, and a region may have holes).
+fn edges_sum(a: &[[DVec3; 2]], b: &[[DVec3; 2]]) -> f64 {
+    let mid = |p: &[[DVec3; 2]]| {
+        let m: DVec3 = p.iter().map(|[u, v]| (*u + *v) * 0.5).sum();
+        m / p.len().max(1) as f64
+    };
+    let extent = |p: &[[DVec3; 2]]| {
+        let c = mid(p);
         p.iter()
-            .map(|v| (*v - c).length_squared())
+            .map(|[v, _]| (*v - c).length_squared())
             .fold(0.0, f64::max)
     };
-    // The smaller polygon is the outer variable, so that subtracting the inner integral at
-    // its centroid leaves an integrand of the size of the result (see the module's note).
+    // The smaller region is the outer variable, so that subtracting the inner integral at
+    // its centre leaves an integrand of the size of the result (see the module's note).
     let (outer, inner) = if extent(a) <= extent(b) {
         (a, b)
     } else {
         (b, a)
     };
-    let c = centroid(outer);
+    let c = mid(outer);
     let mut sum = 0.0;
-    for i in 0..outer.len() {
-        let (p0, p1) = (outer[i], outer[(i + 1) % outer.len()]);
+    for &[p0, p1] in outer {
         let ep = p1 - p0;
         let lp = ep.length();
         if !(lp > TINY_EDGE) {
             continue;
         }
-        for j in 0..inner.len() {
-            let (q0, q1) = (inner[j], inner[(j + 1) % inner.len()]);
+        for &[q0, q1] in inner {
             let eq = q1 - q0;
             let lq = eq.length();
             if !(lq > TINY_EDGE) {
@@ -186,6 +197,32 @@ fn contour_sum(a: &[DVec3], b: &[DVec3]) -> f64 {
         }
     }
     sum
+}
+
+/// `A_r F(r ← s)` for two planar regions given as directed boundary edges (counter-clockwise
+/// around their fronts, any order), each wholly in front of the other's plane or on it: the
+/// caller checks that, since a region of several loops cannot be clipped edge by edge. For
+/// the groups of element triangles of hierarchical radiosity's leaves.
+pub fn edges_coupling(r: &[[DVec3; 2]], s: &[[DVec3; 2]]) -> f64 {
+    let n = 2 * (r.len() + s.len());
+    if r.len() < 3 || s.len() < 3 {
+        return 0.0;
+    }
+    let o = r.iter().chain(s).map(|[a, b]| *a + *b).sum::<DVec3>() / n as f64;
+    let size = r
+        .iter()
+        .chain(s)
+        .map(|[a, _]| (*a - o).length())
+        .fold(0.0, f64::max);
+    if !(size > 0.0) || !size.is_finite() {
+        return 0.0;
+    }
+    let inv = 1.0 / size;
+    let local = |p: &[[DVec3; 2]]| -> Vec<[DVec3; 2]> {
+        p.iter().map(|e| e.map(|v| (v - o) * inv)).collect()
+    };
+    let sum = edges_sum(&local(r), &local(s));
+    (sum / (2.0 * PI)).max(0.0) * size * size
 }
 
 /// A segment with its length and unit direction.
@@ -459,6 +496,39 @@ mod test {
     /// The parallelogram o, o + u, o + u + v, o + v (front along u × v).
     fn rect(o: V, u: V, v: V) -> Vec<V> {
         vec![o, o + u, o + u + v, o + v]
+    }
+
+    fn edges_of(loops: &[Vec<V>]) -> Vec<[V; 2]> {
+        loops
+            .iter()
+            .flat_map(|p| (0..p.len()).map(move |i| [p[i], p[(i + 1) % p.len()]]))
+            .collect()
+    }
+
+    #[test]
+    fn edge_soups_match_their_convex_pieces() {
+        // An L-shaped floor (two rectangles, their shared edge given both ways as two
+        // triangulated leaves would give it) against a wall meeting it along an edge, and
+        // against a plate 5 mm above: the sum of the pieces' couplings.
+        let (x, y, z) = (V::X, V::Y, V::Z);
+        let a = rect(V::ZERO, x, y * 0.5);
+        let b = rect(y * 0.5, x * 0.5, y * 0.5);
+        let wall = rect(V::ZERO, z, x);
+        let plate = rect(z * 0.005 + x * 0.2, y * 0.6, x * 0.1);
+        for other in [&wall, &plate] {
+            let want = polygon_coupling(&a, other) + polygon_coupling(&b, other);
+            let got = edges_coupling(
+                &edges_of(&[a.clone(), b.clone()]),
+                &edges_of(&[other.clone()]),
+            );
+            assert!(rel(got, want) < 1e-10, "{got} {want}");
+            let back = edges_coupling(
+                &edges_of(&[other.clone()]),
+                &edges_of(&[b.clone(), a.clone()]),
+            );
+            assert!(rel(back, want) < 1e-10, "{back} {want}");
+        }
+        assert_eq!(edges_coupling(&[], &edges_of(&[wall])), 0.0);
     }
 
     /// Howell C-11: directly opposed parallel a × b rectangles at distance c.

@@ -268,6 +268,8 @@ fn first_radiosity_range(h: &Hierarchy, leaves: &Leaves) -> Vec<f64> {
 
 /// Cohen et al.'s ambient term for what the sweeps left: the last sweep added `delta`
 /// (area-weighted mean irradiance); each later one would add about ρ times the one before.
+/// The final gather at the vertices is one of those (it gathers the radiosity the last
+/// sweep's irradiance gives), so what is left starts at ρ²: ρ²/(1 − ρ) times `delta`.
 /// Assumes a closed scene.
 fn ambient(h: &Hierarchy, leaves: &Leaves, delta: DVec3) -> DVec3 {
     let area = h.nodes[0].area;
@@ -279,7 +281,7 @@ fn ambient(h: &Hierarchy, leaves: &Leaves, delta: DVec3) -> DVec3 {
         .sum::<DVec3>()
         / area;
     let rho = rho.min(DVec3::splat(0.999));
-    delta.max(DVec3::ZERO) * rho / (DVec3::ONE - rho)
+    delta.max(DVec3::ZERO) * rho * rho / (DVec3::ONE - rho)
 }
 
 #[cfg(test)]

@@ -396,45 +396,33 @@ fn white_furnace_gives_le_over_one_minus_rho() {
         s.patch_size = 0.5;
         s.convergence = 1e-4;
     });
-    let (el_, r) = run(&sc, 4);
+    let (_, r) = run(&sc, 4);
     assert!(r.unshot_fraction < 1e-4);
     let expect = PI * le / (1.0 - rho);
-    let mut worst: f64 = 0.0;
-    for (i, e) in r.irradiance.iter().enumerate() {
-        eprintln!("{:.3?} {:.5}", el_.positions[i], e.x / expect.x);
-    }
-    for e in &r.irradiance {
-        worst = worst.max(((*e - expect) / expect).abs().max_element());
-        assert!(e.x <= expect.x * (1.0 + 1e-9), "{e} above {expect}");
-    }
+    // Each vertex gathers over its leaf's links with its own point factors, which may sum
+    // a little over or under 1 (the factors of far sources are second-order estimates).
+    let worst = r
+        .irradiance
+        .iter()
+        .map(|e| ((*e - expect) / expect).abs().max_element())
+        .fold(0.0, f64::max);
     assert!(worst < 3e-4, "{worst}");
 
-    // Coarse convergence with the ambient term lands about as close.
-    let sc = furnace(rho, le, vec![], |s| {
-        s.patch_size = 0.5;
-        s.convergence = 0.05;
-        s.ambient = true;
-    });
-    let (_, amb) = run(&sc, 4);
-    assert!(amb.unshot_fraction > 1e-3);
-    // The mean: vertices also differ by the coarse links' factors, which the term
-    // cannot know.
-    let off = |r: &IndirectResult| {
+    // Sweeps cut short leave light unshot; the ambient term (each later sweep would add ρ
+    // times the one before) restores most of it.
+    let mean_off = |ambient: bool| {
+        let sc = furnace(rho, le, vec![], |s| {
+            s.patch_size = 0.5;
+            s.convergence = 1e-4;
+            s.max_shots = 4;
+            s.ambient = ambient;
+        });
+        let (_, r) = run(&sc, 4);
         let m = r.irradiance.iter().map(|e| e.x).sum::<f64>() / r.irradiance.len() as f64;
         (m - expect.x).abs() / expect.x
     };
-    let sc = furnace(rho, le, vec![], |s| {
-        s.patch_size = 0.5;
-        s.convergence = 0.05;
-    });
-    let (_, plain) = run(&sc, 4);
-    assert!(
-        off(&amb) < 1.5 * off(&plain) && off(&amb) < amb.unshot_fraction,
-        "{} {} {}",
-        off(&amb),
-        off(&plain),
-        amb.unshot_fraction
-    );
+    let (plain, amb) = (mean_off(false), mean_off(true));
+    assert!(plain > 1e-2 && amb < 0.1 * plain, "{plain} {amb}");
 }
 
 #[test]
