@@ -638,6 +638,118 @@ mod test {
         // The big one seeing the small one: reciprocity through the point factor.
         let back = polygon_factor(&s, &r) * area(&s) / area(&r);
         assert!(rel(back, want) < 1e-7, "{back} vs {want}");
+        // The difference above is the point factor's curvature over the patch; the patch's
+        // own mean is exact.
+        let want = brute(&r, &s, false, 1);
+        assert!(rel(f, want) < 1e-10, "{f} vs {want}: {:e}", rel(f, want));
+    }
+
+    /// Panels on [a, b], halving toward a down to 2^-levels of it.
+    fn graded(a: f64, b: f64, levels: i32) -> Vec<(f64, f64)> {
+        let mut p: Vec<(f64, f64)> = (0..levels)
+            .map(|k| {
+                (
+                    a + (b - a) * 0.5f64.powi(k + 1),
+                    a + (b - a) * 0.5f64.powi(k),
+                )
+            })
+            .collect();
+        p.push((a, a + (b - a) * 0.5f64.powi(levels)));
+        p
+    }
+
+    /// ∫∫ g(x, y) over panels in x and y, 16-point Gauss–Legendre on each.
+    fn tensor(px: &[(f64, f64)], py: &[(f64, f64)], g: impl Fn(f64, f64) -> f64) -> f64 {
+        let rule = gauss_legendre(16);
+        let mut sum = 0.0;
+        for &(x0, x1) in px {
+            for &(y0, y1) in py {
+                for &(xi, wi) in &rule {
+                    for &(yj, wj) in &rule {
+                        let x = 0.5 * (x0 + x1 + (x1 - x0) * xi);
+                        let y = 0.5 * (y0 + y1 + (y1 - y0) * yj);
+                        sum += 0.25 * (x1 - x0) * (y1 - y0) * wi * wj * g(x, y);
+                    }
+                }
+            }
+        }
+        sum
+    }
+
+    /// A floor and a wall leaning away at 60°, their edges a hair apart: the point factor
+    /// varies on the scale of the gap along the whole edge, graded for in the reference.
+    #[test]
+    fn hinged_pair_a_hair_apart_matches_brute_force() {
+        let r = rect(V::ZERO, V::X, V::Y);
+        let d = V::new(-0.5, 0.0, 0.75f64.sqrt());
+        for gap in [1e-2, 1e-3] {
+            let s = rect(V::new(-gap, 0.0, 0.0), V::Y, d);
+            let px = graded(0.0, 1.0, 24);
+            let mut py = graded(0.0, 0.5, 24);
+            py.extend(graded(1.0, 0.5, 24).iter().map(|&(a, b)| (b, a)));
+            let want = tensor(&px, &py, |x, y| point_factor(V::new(x, y, 0.0), V::Z, &s));
+            let f = polygon_factor(&r, &s);
+            assert!(
+                rel(f, want) < 1e-9,
+                "{gap}: {f} vs {want}: {:e}",
+                rel(f, want)
+            );
+        }
+    }
+
+    /// A small element on the floor against a long, low wall strip, touching along a part of
+    /// its bottom edge (the closed form is cut to a window there). Form-factor algebra on
+    /// strips of equal width w gives it: with floor strips f_k and wall strips w_k over
+    /// [0, 0.3], [0.3, 0.31], [0.31, 1], G(f_B, w_A) = ½ (G_AB − G_A − G_B) by the symmetry
+    /// that swaps the planes, each G a common-edge closed form (Howell C-14).
+    #[test]
+    fn small_element_against_a_long_wall_strip() {
+        let w = 0.01;
+        let g = |l: f64| w * l * common_edge(w, w, l);
+        let want =
+            0.5 * (g(0.31) - g(0.3) - g(0.01)) + g(0.01) + 0.5 * (g(0.7) - g(0.69) - g(0.01));
+        let element = rect(V::new(0.0, 0.3, 0.0), V::X * w, V::Y * 0.01);
+        let wall = rect(V::ZERO, V::Y, V::Z * w);
+        let c = polygon_coupling(&element, &wall);
+        assert!(rel(c, want) < 1e-10, "{c} vs {want}: {:e}", rel(c, want));
+        let c = polygon_coupling(&moved(&wall), &moved(&element));
+        assert!(rel(c, want) < 1e-10, "{c} vs {want}: {:e}", rel(c, want));
+    }
+
+    /// Near parallel edges of very different lengths: cutting the longer one to a window
+    /// (whichever of the two is the outer variable) gives the plain closed form's value.
+    #[test]
+    fn windowed_parallel_pairs_agree_with_the_plain_closed_form() {
+        let c = V::new(0.03, 0.2, 0.1);
+        let long = Seg::new(V::new(-0.4, 0.0, 0.0), V::new(0.6, 0.0, 0.0));
+        for (a, h, rev) in [
+            (0.02, 0.0, false),
+            (0.3, 1e-3, true),
+            (0.58, 0.0, true),
+            (0.61, 0.01, false),
+        ] {
+            let (x0, x1) = (V::new(a - 0.4, h, 0.0), V::new(a - 0.4 + 0.05, h, 0.0));
+            let short = if rev {
+                Seg::new(x1, x0)
+            } else {
+                Seg::new(x0, x1)
+            };
+            // J = ∫∫ ln |x − y| from either side.
+            let j_short_outer = edge_pair(short, long, c) + short.len * inner(c, long);
+            let j_long_outer = edge_pair(long, short, c) + long.len * inner(c, short);
+            let lo = (short.a - long.a)
+                .dot(long.dir)
+                .min((short.b - long.a).dot(long.dir));
+            let plain = parallel_closed(long, short, lo, h, c) + long.len * inner(c, short);
+            assert!(
+                (j_short_outer - plain).abs() < 1e-13,
+                "{a}: {j_short_outer} vs {plain}"
+            );
+            assert!(
+                (j_long_outer - plain).abs() < 1e-13,
+                "{a}: {j_long_outer} vs {plain}"
+            );
+        }
     }
 
     /// A chair leg's top 5 mm under the seat, off centre: the seat fills nearly all of the
