@@ -102,7 +102,7 @@ const SMALL_PANEL_POINTS: usize = 6;
 /// use penumbra::geom::polygon_factor::polygon_factor;
 /// // Two unit squares at right angles sharing an edge: F = 0.200044 (Howell C-14).
 /// let floor = [(0., 0.), (1., 0.), (1., 1.), (0., 1.)].map(|(x, y)| DVec3::new(x, y, 0.0));
-/// let wall = [(0., 0.), (0., 1.), (1., 1.), (1., 0.)].map(|(y, z)| DVec3::new(0.0, y, z));
+/// let wall = [(0., 0.), (1., 0.), (1., 1.), (0., 1.)].map(|(y, z)| DVec3::new(0.0, y, z));
 /// let f = polygon_factor(&floor, &wall);
 /// assert!((f - 0.200_043_776_075).abs() < 1e-12, "{f}");
 /// ```
