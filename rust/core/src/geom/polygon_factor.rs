@@ -341,8 +341,8 @@ fn p2(x: f64, h: f64) -> f64 {
     0.25 * (x * x - h * h) * lg - 0.75 * x * x + at
 }
 
-/// `atan2(y, x)` for `y ≥ 0`, through `atan` (libm's `atan2` costs twice as much, and this
-/// is the inner loop).
+/// `atan2(y, x)` for `y ≥ 0`, through `atan`: libm's `atan2` took twice as long, and this
+/// is the inner loop.
 #[inline]
 fn angle(y: f64, x: f64) -> f64 {
     if x > 0.0 {
@@ -440,20 +440,10 @@ fn integrate(f: impl Fn(f64) -> f64, len: f64, sing: &[(f64, f64)]) -> f64 {
             ((-want.ln()) / (2.0 * rho.ln())).ceil() as usize
         };
         let rule = &rules[n.clamp(2, MAX_POINTS)];
-        #[cfg(test)]
-        {
-            EVALS.fetch_add(rule.len(), std::sync::atomic::Ordering::Relaxed);
-            PANELS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        }
         sum += hl * rule.iter().map(|&(x, w)| w * f(m + hl * x)).sum::<f64>();
     }
     sum
 }
-
-#[cfg(test)]
-pub(crate) static EVALS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-#[cfg(test)]
-pub(crate) static PANELS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
 /// Ratio (semi-axes' sum) of the Bernstein ellipse with foci ±1 through `x + iy`.
 #[inline]
@@ -1047,17 +1037,19 @@ mod test {
         }
     }
 
+    type Pairs = Vec<(Vec<V>, Vec<V>)>;
+
     /// ns per call; `cargo test -p penumbra --release --lib polygon_factor_timing --
     /// --ignored --nocapture`.
     #[test]
     #[ignore]
     fn polygon_factor_timing() {
         let mut rng = Rng(7);
-        let randoms: Vec<(Vec<V>, Vec<V>)> = (0..2000)
+        let randoms: Pairs = (0..2000)
             .map(|_| (rng.polygon(), rng.polygon()))
             .filter(|(r, s)| polygon_coupling(r, s) > 0.0)
             .collect();
-        let quads: Vec<(Vec<V>, Vec<V>)> = (0..2000)
+        let quads: Pairs = (0..2000)
             .map(|_| {
                 let r = rect(V::ZERO, V::X, V::Y);
                 let o = V::new(rng.range(-1., 1.), rng.range(-1., 1.), rng.range(0.5, 2.));
@@ -1080,7 +1072,7 @@ mod test {
             V::Y,
             V::new(-0.5, 0.0, 0.75f64.sqrt()),
         );
-        let cases: [(&str, Vec<(Vec<V>, Vec<V>)>); 8] = [
+        let cases: [(&str, Pairs); 8] = [
             ("triangles sharing a vertex", one(&tri_r, &tri_s)),
             (
                 "hinged squares 1 mm apart at 120 degrees",
@@ -1121,17 +1113,6 @@ mod test {
             println!(
                 "{name}: {ns:.0} ns/call over {} pairs ({acc:.3})",
                 pairs.len()
-            );
-            use std::sync::atomic::Ordering::Relaxed;
-            EVALS.store(0, Relaxed);
-            PANELS.store(0, Relaxed);
-            for (r, s) in &pairs {
-                polygon_factor(r, s);
-            }
-            println!(
-                "  {:.1} evals, {:.1} panels per call",
-                EVALS.load(Relaxed) as f64 / pairs.len() as f64,
-                PANELS.load(Relaxed) as f64 / pairs.len() as f64
             );
         }
     }
