@@ -1014,6 +1014,14 @@ mod test {
         let mut flipped = above.clone();
         flipped.reverse();
         assert_eq!(polygon_factor(&sq, &flipped), 0.0);
+        // A repeated vertex is an edge of no length: the same factor.
+        let doubled = vec![sq[0], sq[1], sq[1], sq[2], sq[3]];
+        assert!(
+            rel(
+                polygon_factor(&doubled, &above),
+                polygon_factor(&sq, &above)
+            ) < 1e-14
+        );
         // A tiny sliver next to a big face stays finite.
         let sliver = rect(V::ZERO, V::Y, V::new(0.0, 0.0, 1e-300));
         assert!(polygon_factor(&sq, &sliver).is_finite());
