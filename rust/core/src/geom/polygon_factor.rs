@@ -279,6 +279,10 @@ fn parallel_pair(p: Seg, q: Seg, lo: f64, h: f64, c: DVec3) -> f64 {
         let to_q = |s: f64| if forward { s - lo } else { q.len - (s - lo) };
         let (u0, u1) = (to_q(-w), to_q(p.len + w));
         let (u0, u1) = (u0.min(u1).max(0.0), u0.max(u1).min(q.len));
+        if u1 <= u0 {
+            // q lies wholly beyond the window: at least w away, nothing near to resolve.
+            return quadrature_pair(p, q, c);
+        }
         let mut sum = 0.0;
         if u0 > 0.0 {
             sum += quadrature_pair(p, q.part(0.0, u0), c);
@@ -292,6 +296,9 @@ fn parallel_pair(p: Seg, q: Seg, lo: f64, h: f64, c: DVec3) -> f64 {
     }
     if p.len > (1.0 + 2.0 * WINDOW) * q.len {
         let (s0, s1) = ((lo - w).max(0.0), (lo + q.len + w).min(p.len));
+        if s1 <= s0 {
+            return quadrature_pair(p, q, c);
+        }
         let mut sum = 0.0;
         if s0 > 0.0 {
             sum += quadrature_pair(p.part(0.0, s0), q, c);
@@ -759,8 +766,24 @@ mod test {
         assert!(rel(c, want) < 1e-10, "{c} vs {want}: {:e}", rel(c, want));
     }
 
+    /// Regression: an element on the floor just past the end of a long, low wall strip, its
+    /// edge on the line of the strip's bottom edge but beyond it. The window around the
+    /// element's edge missed the strip's edge, the closed form ran over a negative length,
+    /// and F came out 0 instead of 8.3e-4.
+    #[test]
+    fn element_past_the_end_of_a_wall_strip() {
+        let element = rect(V::new(0.0, 1.13, 0.0), V::X * 0.05, V::Y * 0.05);
+        let wall = rect(V::ZERO, V::Y, V::Z * 0.05);
+        let f = polygon_factor(&element, &wall);
+        let want = brute(&element, &wall, false, 4);
+        assert!(rel(f, want) < 1e-10, "{f} vs {want}: {:e}", rel(f, want));
+        let back = polygon_factor(&wall, &element) * area(&wall) / area(&element);
+        assert!(rel(back, want) < 1e-10, "{back} vs {want}");
+    }
+
     /// Near parallel edges of very different lengths: cutting the longer one to a window
-    /// (whichever of the two is the outer variable) gives the plain closed form's value.
+    /// (whichever of the two is the outer variable) gives the plain closed form's value,
+    /// also when the short edge lies beyond the long one's end and the window misses it.
     #[test]
     fn windowed_parallel_pairs_agree_with_the_plain_closed_form() {
         let c = V::new(0.03, 0.2, 0.1);
@@ -770,6 +793,8 @@ mod test {
             (0.3, 1e-3, true),
             (0.58, 0.0, true),
             (0.61, 0.01, false),
+            (1.13, 0.0, false),
+            (1.13, 2e-3, true),
         ] {
             let (x0, x1) = (V::new(a - 0.4, h, 0.0), V::new(a - 0.4 + 0.05, h, 0.0));
             let short = if rev {
