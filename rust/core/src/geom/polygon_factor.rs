@@ -1017,6 +1017,51 @@ mod test {
         assert!(nonzero > 100, "{nonzero}");
     }
 
+    /// Architecture-like pairs: rectangles on a grid in a floor, a wall and a ceiling a
+    /// little above, so that edges are collinear, parallel and near, with all length
+    /// ratios; cutting the receiver along a grid line must not change the transfer.
+    #[test]
+    fn grid_rectangles_cut_add_up() {
+        let mut rng = Rng(0x1234_5678);
+        let mut grid = |n: f64| (rng.next() * n).floor() * 0.05;
+        let mut checked = 0;
+        for case in 0..400 {
+            let (x0, y0) = (grid(10.0), grid(20.0));
+            let (w, l) = (0.05 + grid(10.0), 0.05 + grid(20.0));
+            let r = rect(V::new(x0, y0, 0.0), V::X * w, V::Y * l);
+            let (a, b) = (grid(20.0), grid(10.0));
+            let (da, db) = (0.05 + grid(20.0), 0.05 + grid(10.0));
+            let s = match case % 3 {
+                0 => rect(V::new(0.0, a, b), V::Y * da, V::Z * db),
+                1 => rect(V::new(b, a, 0.0), V::Z * db, V::Y * da),
+                _ => rect(V::new(b, a, 0.01 + grid(4.0)), V::Y * da, V::X * db),
+            };
+            let whole = polygon_coupling(&r, &s);
+            if whole == 0.0 {
+                continue;
+            }
+            checked += 1;
+            let cut = x0 + 0.05 * (1.0 + (w / 0.05 - 1.0).floor().max(0.0) * 0.5).floor();
+            let parts = if cut > x0 && cut < x0 + w {
+                polygon_coupling(&rect(r[0], V::X * (cut - x0), V::Y * l), &s)
+                    + polygon_coupling(
+                        &rect(V::new(cut, y0, 0.0), V::X * (x0 + w - cut), V::Y * l),
+                        &s,
+                    )
+            } else {
+                let cut = y0 + l * 0.5;
+                polygon_coupling(&rect(r[0], V::X * w, V::Y * (cut - y0)), &s)
+                    + polygon_coupling(
+                        &rect(V::new(x0, cut, 0.0), V::X * w, V::Y * (y0 + l - cut)),
+                        &s,
+                    )
+            };
+            let err = (parts - whole).abs() / whole.max(1e-5 * area(&r).min(area(&s)));
+            assert!(err < 1e-9, "{case}: {parts} vs {whole}");
+        }
+        assert!(checked > 150, "{checked}");
+    }
+
     #[test]
     fn degenerate_input_is_zero_not_nan() {
         let sq = rect(V::ZERO, V::X, V::Y);
