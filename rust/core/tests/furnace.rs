@@ -44,8 +44,13 @@ fn closed_emissive_box_reaches_le_over_one_minus_rho() {
             .fold(0.0, f64::max);
         let mean = c.iter().map(|x| x[0]).sum::<f64>() / c.len() as f64;
         // The hierarchical solver's vertices gather with second-order estimates of far
-        // factors (its mean is within 1e-5 of Le / (1 − ρ)).
-        let bound = if solver.is_some() { 3e-3 } else { 2e-3 };
+        // factors, and its links give a leaf the mean factor of the node they end at: its
+        // mean is within 5e-4, single vertices within 0.9 % at ρ = 0.8 (0.2 % at ρ = 0.5).
+        let bound = if solver.is_some() { 1e-2 } else { 2e-3 };
+        assert!(
+            (mean - want).abs() < 1e-3 * want,
+            "{solver:?} rho {rho}: mean {mean}"
+        );
         assert!(
             worst < bound,
             "{solver:?} rho {rho}: worst relative error {worst:e}, mean {mean} want {want}"
