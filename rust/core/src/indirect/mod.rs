@@ -115,6 +115,19 @@ pub fn indirect(
     indirect_at(scene, el, direct, occ, progress, spacing)
 }
 
+/// One direct irradiance per element vertex, or an error naming the stage.
+fn check_direct(el: &Elements, direct: &[DVec3]) -> Result<(), BakeError> {
+    let nv = el.positions.len();
+    if direct.len() != nv {
+        return Err(BakeError::invalid(
+            "indirect",
+            "direct",
+            format!("{} values for {nv} element vertices", direct.len()),
+        ));
+    }
+    Ok(())
+}
+
 /// `indirect`, computed at vertices about `spacing` apart (every vertex for 0).
 fn indirect_at(
     scene: &Scene,
@@ -126,13 +139,7 @@ fn indirect_at(
 ) -> Result<IndirectResult, BakeError> {
     let settings = &scene.settings;
     let nv = el.positions.len();
-    if direct.len() != nv {
-        return Err(BakeError::invalid(
-            "indirect",
-            "direct",
-            format!("{} values for {nv} element vertices", direct.len()),
-        ));
-    }
+    check_direct(el, direct)?;
     let cover_tol = 1e-6 * scene.diagonal();
     let covers = crate::indirect::coplanar_contacts::covers(&scene.faces, cover_tol);
     let open = crate::indirect::coplanar_contacts::open_parts_of(&scene.faces, &covers, cover_tol);

@@ -72,13 +72,7 @@ pub fn indirect(
 ) -> Result<IndirectResult, BakeError> {
     let settings = &scene.settings;
     let nv = el.positions.len();
-    if direct.len() != nv {
-        return Err(BakeError::invalid(
-            "indirect",
-            "direct",
-            format!("{} values for {nv} element vertices", direct.len()),
-        ));
-    }
+    super::check_direct(el, direct)?;
     let faces = &scene.faces;
     let covers = crate::indirect::coplanar_contacts::covers(faces, 1e-6 * scene.diagonal());
     let leaf_radius = LEAF_RADIUS * settings.patch_size;
