@@ -354,6 +354,11 @@ impl Hierarchy {
     }
 
     /// Index of the leaf node `n`.
+    /// The boundary edges of node `i` if it is a leaf (`set_boxes`), else none.
+    pub fn leaf_edges(&self, i: usize) -> &[[DVec3; 2]] {
+        &self.edges[self.edge_start[i] as usize..self.edge_start[i + 1] as usize]
+    }
+
     pub fn leaf_index(&self, n: &Node) -> usize {
         self.leaf_node[n.lo as usize] as usize
     }

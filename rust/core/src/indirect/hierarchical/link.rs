@@ -159,9 +159,7 @@ fn exact_pair(h: &Hierarchy, r: u32, s: u32, nr: DVec3, ns: DVec3) -> Option<f64
     if !rn.is_leaf() || !sn.is_leaf() || !(rn.area > 0.0) {
         return None;
     }
-    let edges =
-        |i: u32| &h.edges[h.edge_start[i as usize] as usize..h.edge_start[i as usize + 1] as usize];
-    let (re, se) = (edges(r), edges(s));
+    let (re, se) = (h.leaf_edges(r as usize), h.leaf_edges(s as usize));
     let tol = 1e-9 * (rn.radius() + sn.radius());
     let in_front =
         |e: &[[DVec3; 2]], c: DVec3, n: DVec3| e.iter().all(|[a, _]| (*a - c).dot(n) >= -tol);
@@ -178,9 +176,7 @@ pub fn exact_factor(h: &Hierarchy, el: &Elements, p: DVec3, n: DVec3, s: &Node, 
         if (p - s.centroid).dot(ns) <= 0.0 {
             return 0.0;
         }
-        let i = h.leaf_index(s);
-        let edges = &h.edges[h.edge_start[i] as usize..h.edge_start[i + 1] as usize];
-        if let Some(e) = edges_irradiance(p, n, edges) {
+        if let Some(e) = edges_irradiance(p, n, h.leaf_edges(h.leaf_index(s))) {
             return e / std::f64::consts::PI;
         }
     }
