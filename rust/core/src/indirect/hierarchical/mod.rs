@@ -100,6 +100,7 @@ pub fn indirect(
         return Ok(result);
     }
 
+    h.weigh(el, &radiosity_estimate(&h, &leaves, emitted_power));
     let b_max = radiosity_bounds(&h, &leaves, emitted_power);
     let b_range = first_radiosity_range(&h, &leaves);
     let max_links = LINKS_PER_LEAF * nl as u64 + LINK_FLOOR;
@@ -234,6 +235,24 @@ fn radiosity_bounds(h: &Hierarchy, leaves: &Leaves, emitted_power: f64) -> Vec<f
         };
     }
     b
+}
+
+/// Per leaf position, an estimate of its radiosity over the solve (channels summed): its
+/// first radiosity plus its albedo times the mean irradiance the bounces give a closed scene
+/// (the emitted power over the area, over 1 − ρ), for `Hierarchy::weigh`.
+fn radiosity_estimate(h: &Hierarchy, leaves: &Leaves, emitted_power: f64) -> Vec<f64> {
+    let area = h.nodes.first().map_or(0.0, |n| n.area).max(1e-300);
+    let rho_mean = (0..h.order.len())
+        .map(|i| leaves.albedo[i] * h.area[i])
+        .sum::<DVec3>()
+        / area;
+    let bounce = emitted_power / area / (1.0 - rho_mean.element_sum() / 3.0).max(0.05) / 3.0;
+    (0..h.order.len())
+        .map(|p| {
+            let first = leaves.albedo[p] * leaves.direct[p] + leaves.emitted[p];
+            first.element_sum() + leaves.albedo[p].element_sum() * bounce
+        })
+        .collect()
 }
 
 /// Per node, how much its leaves' first radiosity (reflected direct light plus emission,
