@@ -236,18 +236,17 @@ impl<'a> Refiner<'a> {
         }
         // Something may be in the way of a link carrying much: sample it more densely.
         let rays = if error > self.eps / 4.0 { self.rays } else { 4 };
-        let (v, cast) = self.vis.fraction_among(rn, sn, blockers.as_deref(), rays);
+        // A pair that any blocked segment would split needs no more rays after the first.
+        let splits = !both_leaves && power > self.eps / SHADOW;
+        let (v, cast) = self
+            .vis
+            .fraction_among(rn, sn, blockers.as_deref(), rays, splits);
         if cast > 0 {
             self.rays_cast.fetch_add(cast as u64, Ordering::Relaxed);
         }
         // Partly hidden: the shadow varies over the receiver, and a mean over it would
         // light its dark part (the seat right above a leg). Split the receiver first.
-        if v < 1.0
-            && (v > 0.0 || cast > 0)
-            && !both_leaves
-            && power > self.eps / SHADOW
-            && !self.over_budget()
-        {
+        if v < 1.0 && (v > 0.0 || cast > 0) && splits && !self.over_budget() {
             return if rn.is_leaf() {
                 self.split_larger(r, s, blockers.as_deref(), out)
             } else {

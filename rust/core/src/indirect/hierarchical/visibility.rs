@@ -86,16 +86,19 @@ impl Visibility<'_> {
     /// without a ray when nothing can be in the way. Also returns the rays cast.
     #[cfg(test)]
     pub fn fraction(&self, r: &Node, s: &Node, rays: u32) -> (f64, u32) {
-        self.fraction_among(r, s, self.blockers(r, s).as_deref(), rays)
+        self.fraction_among(r, s, self.blockers(r, s).as_deref(), rays, false)
     }
 
     /// `fraction`, given the `blockers` between `r` and `s` (`None`: unknown, use the BVH).
+    /// With `until_blocked`, stops at the first blocked segment, with the fraction so far
+    /// (under 1): for a caller that splits any pair something hides.
     pub fn fraction_among(
         &self,
         r: &Node,
         s: &Node,
         list: Option<&[u32]>,
         rays: u32,
+        until_blocked: bool,
     ) -> (f64, u32) {
         if list.is_some_and(|l| l.is_empty()) {
             return (1.0, 0);
@@ -134,6 +137,8 @@ impl Visibility<'_> {
                 total += w;
                 if !blocked(a, b) {
                     open += w;
+                } else if until_blocked {
+                    break;
                 }
             }
         }
