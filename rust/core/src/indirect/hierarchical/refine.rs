@@ -224,8 +224,12 @@ impl<'a> Refiner<'a> {
                 return self.split(&[(r, a), (r, b)], inherited, out);
             }
         }
+        // A faint pair is never split, so its shaft list would only spare it a few rays;
+        // in clutter most shaft queries give up past their cap anyway (room-245: 2.1M of
+        // 2.9M), and the query costs more than the rays.
         let blockers = match inherited {
             Some(l) => Some(self.vis.blockers_among(rn, sn, l)),
+            None if faint => None,
             None => self.vis.blockers(rn, sn),
         };
         // A shaft with something in it is treated as partly blocked without a ray: a few
