@@ -26,9 +26,8 @@ pub struct Visibility<'a> {
 }
 
 impl Visibility<'_> {
-    /// What could block some segment between `r` and `s`: nothing, a short list of faces,
-    /// or too many to list (`None`: ask the BVH per segment).
-    pub fn blockers(&self, r: &Node, s: &Node) -> Option<Vec<u32>> {
+    /// The planes of `r` and `s` that are planar, and their faces (which never block).
+    fn planes(&self, r: &Node, s: &Node) -> (Vec<Plane>, Vec<u32>) {
         let mut planes: Vec<Plane> = Vec::with_capacity(2);
         let mut skip: Vec<u32> = Vec::with_capacity(2);
         for n in [r, s] {
@@ -37,6 +36,13 @@ impl Visibility<'_> {
                 skip.push(n.face);
             }
         }
+        (planes, skip)
+    }
+
+    /// What could block some segment between `r` and `s`: nothing, a short list of faces,
+    /// or too many to list (`None`: ask the BVH per segment).
+    pub fn blockers(&self, r: &Node, s: &Node) -> Option<Vec<u32>> {
+        let (planes, skip) = self.planes(r, s);
         let (lo, hi) = (r.lo_box.min(s.lo_box), r.hi_box.max(s.hi_box));
         let mut out = Vec::new();
         if !self
@@ -61,14 +67,7 @@ impl Visibility<'_> {
         if list.is_empty() {
             return Vec::new();
         }
-        let mut planes: Vec<Plane> = Vec::with_capacity(2);
-        let mut skip: Vec<u32> = Vec::with_capacity(2);
-        for n in [r, s] {
-            if n.is_planar() {
-                planes.push(self.faces[n.face as usize].plane);
-                skip.push(n.face);
-            }
-        }
+        let (planes, skip) = self.planes(r, s);
         let (lo, hi) = (r.lo_box.min(s.lo_box), r.hi_box.max(s.hi_box));
         let corners = corners(r);
         list.iter()
