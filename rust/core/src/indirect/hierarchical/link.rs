@@ -215,6 +215,21 @@ mod test {
     use crate::indirect::patches::test::grid_elements;
     use crate::scene::test::face;
 
+    /// The hierarchy over two faces meshed 4×4, one leaf per triangle, and the nodes of
+    /// face 0 (the receiver) and face 1.
+    fn face_nodes(faces: &[Face]) -> (Hierarchy, Elements, u32, u32) {
+        let el = grid_elements(faces, 4);
+        let mut h = Hierarchy::build(faces, &el, |_| true, 0.0);
+        h.set_boxes(faces, &el);
+        let [a, b] = h.nodes[0].kids;
+        let (r, s) = if h.nodes[a as usize].face == 0 {
+            (a, b)
+        } else {
+            (b, a)
+        };
+        (h, el, r, s)
+    }
+
     #[test]
     fn exact_and_estimated_factors_agree_far_away_and_bound_holds() {
         let v = DVec3::new;
@@ -240,15 +255,7 @@ mod test {
             DVec3::ZERO,
         );
         let faces = [bottom, top];
-        let el = grid_elements(&faces, 4);
-        let mut h = Hierarchy::build(&faces, &el, |_| true, 0.0);
-        h.set_boxes(&faces, &el);
-        let [a, b] = h.nodes[0].kids;
-        let (r, s) = if h.nodes[a as usize].face == 0 {
-            (a, b)
-        } else {
-            (b, a)
-        };
+        let (h, el, r, s) = face_nodes(&faces);
         let ends = Ends::new(&h, &faces, r, s);
         let l = ends.link(&h, &el, r, s, 1.0, true);
         // Exact: a point under a small square's centre: F ≈ A/(π·h²).
@@ -324,15 +331,7 @@ mod test {
         // without sampling (it carries little) once took a far-field correction that is
         // unbounded this near, and the solve ran to 1e171.
         let faces = [unit_square(0.0, true), unit_square(0.005, false)];
-        let el = grid_elements(&faces, 4);
-        let mut h = Hierarchy::build(&faces, &el, |_| true, 0.0);
-        h.set_boxes(&faces, &el);
-        let [a, b] = h.nodes[0].kids;
-        let (r, s) = if h.nodes[a as usize].face == 0 {
-            (a, b)
-        } else {
-            (b, a)
-        };
+        let (h, el, r, s) = face_nodes(&faces);
         assert!(!h.nodes[r as usize].is_leaf() && !h.nodes[s as usize].is_leaf());
         let ends = Ends::new(&h, &faces, r, s);
         let k = ends.link(&h, &el, r, s, 1.0, false).k;
