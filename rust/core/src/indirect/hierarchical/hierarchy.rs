@@ -151,12 +151,7 @@ impl Hierarchy {
                 .total_cmp(&b.0[axis])
                 .then(a.1[0].face.cmp(&b.1[0].face))
         });
-        let id = self.open();
-        let (a, b) = groups.split_at_mut(mid);
-        let ka = self.faces(a);
-        let kb = self.faces(b);
-        self.close(id, [ka, kb]);
-        id
+        self.halves(groups, mid, Self::faces)
     }
 
     /// A face's levels: its regions, split into halves by leaf count, then each region's
@@ -176,12 +171,7 @@ impl Hierarchy {
         } else {
             end
         };
-        let id = self.open();
-        let (a, b) = leaves.split_at_mut(cut);
-        let ka = self.regions(a);
-        let kb = self.regions(b);
-        self.close(id, [ka, kb]);
-        id
+        self.halves(leaves, cut, Self::regions)
     }
 
     /// A region's triangles split at the median of their centroids on the longest axis.
@@ -221,10 +211,20 @@ impl Hierarchy {
                 .total_cmp(&b.centroid[axis])
                 .then(a.tri.cmp(&b.tri))
         });
+        self.halves(leaves, mid, Self::triangles)
+    }
+
+    /// An inner node over `items` cut at `cut`, each half built by `level`.
+    fn halves<T>(
+        &mut self,
+        items: &mut [T],
+        cut: usize,
+        level: fn(&mut Self, &mut [T]) -> u32,
+    ) -> u32 {
         let id = self.open();
-        let (a, b) = leaves.split_at_mut(mid);
-        let ka = self.triangles(a);
-        let kb = self.triangles(b);
+        let (a, b) = items.split_at_mut(cut);
+        let ka = level(self, a);
+        let kb = level(self, b);
         self.close(id, [ka, kb]);
         id
     }
