@@ -185,9 +185,6 @@ impl<'a> Refiner<'a> {
         let faint = power <= self.eps / NEAR_POWER;
         let near = near && !faint;
         if !both_leaves && (near || error > self.eps) && !self.over_budget() {
-            if near {
-            } else {
-            }
             return self.split_larger(r, s, inherited, out);
         }
         // The link gives every point of the receiver its mean factor: where the factor
