@@ -15,7 +15,9 @@
 //! itself (`vertices`). Every step gives the same bits
 //! for any thread count.
 //!
-//! Parts of faces lying against another face (`covered`) neither shoot nor receive.
+//! Parts of faces lying against another face (`covered`) neither shoot nor receive. The
+//! backs of thin faces with something behind them are faces of their own in the hierarchy
+//! (`back`), which receive and shoot into the half-space behind.
 //!
 //! Settings: `convergence` sets both the link tolerance and the end of the solve;
 //! `visibility_rays` is the ray count for links carrying the most; `max_shots` caps the
