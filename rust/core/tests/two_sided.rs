@@ -7,6 +7,8 @@
 //! `ρ·E·cos θ / π` there and nothing in the shadow. The floor gets that through Lambert's
 //! exact factors to the plane and to the shadow rectangle, and nothing else: the floor
 //! is black, so no light goes round twice.
+//!
+//! Each test runs with both indirect solvers (`SOLVERS`), to the same bounds.
 
 mod common;
 use common::*;
@@ -18,6 +20,8 @@ const SUN: f64 = 3.0;
 /// Half-sizes: the plane at height 1, the floor at 0.
 const PLANE: f64 = 3.0;
 const FLOOR: f64 = 0.5;
+/// The indirect solvers, as `settings.indirect_solver` names them (`None`: the default).
+const SOLVERS: [Option<&str>; 2] = [None, Some("hierarchical")];
 
 fn sun() -> LightJson {
     LightJson {
@@ -28,9 +32,10 @@ fn sun() -> LightJson {
     }
 }
 
-fn settings(patch_size: f64) -> SettingsJson {
+fn settings(patch_size: f64, solver: Option<&str>) -> SettingsJson {
     SettingsJson {
         indirect: Some(true),
+        indirect_solver: solver.map(String::from),
         lighting_only: Some(true),
         patch_size: Some(patch_size),
         element_size: Some(0.1),
@@ -70,16 +75,20 @@ fn floor_error(b: &penumbra::Bake) -> (f64, f64) {
 
 #[test]
 fn plane_lit_from_behind_lights_the_floor_from_its_back() {
-    let mut plane = mesh("Plane", vec![quad([0., 0., 1.], PLANE, PLANE, true)]);
-    plane.albedo = Some(penumbra::scene::json::PerPolygon::Uniform([RHO; 3]));
-    let s = scene(vec![floor(), plane], vec![sun()], settings(0.1));
-    let b = bake(&s);
-    let (worst, mean) = floor_error(&b);
-    eprintln!("plane from behind: floor mean {mean:.5}, worst error {worst:.4} of it");
-    assert!(mean > 0.05, "{mean}");
-    assert!(worst < 0.02, "{worst}");
-    // Cycles bakes the front only, and so do we: the plane's front sees no light.
-    assert!(b.meshes[1].colors.iter().all(|c| c[0] == 0.0));
+    for solver in SOLVERS {
+        let mut plane = mesh("Plane", vec![quad([0., 0., 1.], PLANE, PLANE, true)]);
+        plane.albedo = Some(penumbra::scene::json::PerPolygon::Uniform([RHO; 3]));
+        let s = scene(vec![floor(), plane], vec![sun()], settings(0.1, solver));
+        let b = bake(&s);
+        let (worst, mean) = floor_error(&b);
+        eprintln!(
+            "{solver:?} plane from behind: floor mean {mean:.5}, worst error {worst:.4} of it"
+        );
+        assert!(mean > 0.05, "{solver:?} {mean}");
+        assert!(worst < 0.02, "{solver:?} {worst}");
+        // Cycles bakes the front only, and so do we: the plane's front sees no light.
+        assert!(b.meshes[1].colors.iter().all(|c| c[0] == 0.0), "{solver:?}");
+    }
 }
 
 /// A closed box reflects from its front only: the same light on its underside (a front,
@@ -87,13 +96,15 @@ fn plane_lit_from_behind_lights_the_floor_from_its_back() {
 /// box, sends nothing.
 #[test]
 fn closed_box_reflects_from_its_outside_only() {
-    let mut slab = mesh("Slab", cuboid([-PLANE, -PLANE, 1.0], [PLANE, PLANE, 1.2]));
-    slab.albedo = Some(penumbra::scene::json::PerPolygon::Uniform([RHO; 3]));
-    let s = scene(vec![floor(), slab], vec![sun()], settings(0.1));
-    let b = bake(&s);
-    let (worst, mean) = floor_error(&b);
-    eprintln!("box from below: floor mean {mean:.5}, worst error {worst:.4} of it");
-    assert!(worst < 0.02, "{worst}");
+    for solver in SOLVERS {
+        let mut slab = mesh("Slab", cuboid([-PLANE, -PLANE, 1.0], [PLANE, PLANE, 1.2]));
+        slab.albedo = Some(penumbra::scene::json::PerPolygon::Uniform([RHO; 3]));
+        let s = scene(vec![floor(), slab], vec![sun()], settings(0.1, solver));
+        let b = bake(&s);
+        let (worst, mean) = floor_error(&b);
+        eprintln!("{solver:?} box from below: floor mean {mean:.5}, worst error {worst:.4} of it");
+        assert!(worst < 0.02, "{solver:?} {worst}");
+    }
 }
 
 /// A box standing on the plane covers the plane's front under it (`coplanar_contacts`),
@@ -105,17 +116,34 @@ fn a_box_on_the_plane_covers_its_front_not_its_back() {
         p.albedo = Some(penumbra::scene::json::PerPolygon::Uniform([RHO; 3]));
         p
     };
-    let without = bake(&scene(vec![floor(), plane()], vec![sun()], settings(0.2)));
-    let stand = mesh("Box", cuboid([0.0, -0.6, 1.0], [0.8, 0.6, 1.5]));
-    let with = bake(&scene(
-        vec![floor(), plane(), stand],
-        vec![sun()],
-        settings(0.2),
-    ));
-    let (a, b) = (&without.meshes[0], &with.meshes[0]);
-    assert_eq!(a.positions, b.positions);
-    let top = a.colors.iter().map(|c| c[0]).fold(0.0, f64::max);
-    for (x, y) in a.colors.iter().zip(&b.colors) {
-        assert!((x[0] - y[0]).abs() <= 1e-3 * top, "{x:?} {y:?}");
+    for solver in SOLVERS {
+        let without = bake(&scene(
+            vec![floor(), plane()],
+            vec![sun()],
+            settings(0.2, solver),
+        ));
+        let stand = mesh("Box", cuboid([0.0, -0.6, 1.0], [0.8, 0.6, 1.5]));
+        let with = bake(&scene(
+            vec![floor(), plane(), stand],
+            vec![sun()],
+            settings(0.2, solver),
+        ));
+        let (a, b) = (&without.meshes[0], &with.meshes[0]);
+        assert_eq!(a.positions, b.positions);
+        let top = a.colors.iter().map(|c| c[0]).fold(0.0, f64::max);
+        assert!(top > 0.0, "{solver:?}");
+        let diff = a
+            .colors
+            .iter()
+            .zip(&b.colors)
+            .map(|(x, y)| (x[0] - y[0]).abs())
+            .fold(0.0, f64::max);
+        eprintln!(
+            "{solver:?} box on plane: largest difference {:.2e} of the brightest",
+            diff / top
+        );
+        for (x, y) in a.colors.iter().zip(&b.colors) {
+            assert!((x[0] - y[0]).abs() <= 1e-3 * top, "{solver:?} {x:?} {y:?}");
+        }
     }
 }

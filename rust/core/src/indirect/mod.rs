@@ -68,8 +68,8 @@ pub struct IndirectResult {
     /// sweep added, over the power emitted.
     pub unshot_fraction: f64,
     /// Hierarchical solver only: links after refinement, leaves (element triangles not
-    /// under a cover), visibility rays cast while refining, and memory of the hierarchy and
-    /// links per leaf in bytes.
+    /// under a cover, and again for each back of a thin face), visibility rays cast while
+    /// refining, and memory of the hierarchy and links per leaf in bytes.
     pub links: u64,
     pub leaves: u64,
     pub rays: u64,

@@ -69,6 +69,10 @@ pub struct Hierarchy {
     /// if it is a leaf: `edges[edge_start[i]..edge_start[i + 1]]` (`set_boxes`).
     pub edge_start: Vec<u32>,
     pub edges: Vec<[DVec3; 2]>,
+    /// Face ids from `first_back` on are the backs of thin faces (`back`): id
+    /// `first_back + k` is the back of face `back_face[k]`.
+    pub first_back: u32,
+    pub back_face: Vec<u32>,
     leaf_radius: f64,
 }
 
@@ -90,27 +94,54 @@ impl Hierarchy {
     /// `leaf_radius`: the leaves are groups of element triangles about that size, so the
     /// tree (and the links) scale with the area over the leaf size, not with the element
     /// count, which follows direct light's penumbrae.
+    // The bake builds with backs (`build_two_sided`); unit tests build without.
+    #[cfg_attr(not(test), allow(dead_code))]
     pub fn build(
         faces: &[Face],
         el: &Elements,
         keep: impl Fn(u32) -> bool,
         leaf_radius: f64,
     ) -> Self {
+        Self::build_two_sided(faces, el, keep, leaf_radius, &[])
+    }
+
+    /// `build`, with the backs of the faces `backs` as faces of their own: `faces` ends with
+    /// one turned-round copy of each (`back`), whose leaves are all the face's triangles
+    /// (`keep` is about fronts).
+    pub fn build_two_sided(
+        faces: &[Face],
+        el: &Elements,
+        keep: impl Fn(u32) -> bool,
+        leaf_radius: f64,
+        backs: &[u32],
+    ) -> Self {
+        let first_back = faces.len() - backs.len();
+        let mut back_of = vec![NONE; first_back];
+        for (k, &f) in backs.iter().enumerate() {
+            back_of[f as usize] = (first_back + k) as u32;
+        }
         let mut by_face: Vec<Vec<Leaf>> = vec![Vec::new(); faces.len()];
         for (t, tri) in el.triangles.iter().enumerate() {
             let p = tri.map(|v| el.positions[v as usize]);
             let area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length();
-            if !(area > 0.0) || !area.is_finite() || !keep(t as u32) {
+            if !(area > 0.0) || !area.is_finite() {
                 continue;
             }
             let face = el.tri_face[t];
-            by_face[face as usize].push(Leaf {
+            let leaf = Leaf {
                 tri: t as u32,
                 face,
                 region: el.tri_region[t],
                 area,
                 centroid: (p[0] + p[1] + p[2]) / 3.0,
-            });
+            };
+            let back = back_of[face as usize];
+            if back != NONE {
+                by_face[back as usize].push(Leaf { face: back, ..leaf });
+            }
+            if keep(t as u32) {
+                by_face[face as usize].push(leaf);
+            }
         }
         let mut groups: Vec<(DVec3, Vec<Leaf>)> = by_face
             .into_iter()
@@ -122,6 +153,8 @@ impl Hierarchy {
             .collect();
         let mut h = Hierarchy {
             leaf_radius,
+            first_back: first_back as u32,
+            back_face: backs.to_vec(),
             ..Default::default()
         };
         if !groups.is_empty() {
@@ -422,12 +455,26 @@ impl Hierarchy {
         }
     }
 
-    /// Index of the leaf node `n`.
+    /// The scene face that face id `f` lies on: itself, or for a back the face it is the
+    /// back of.
+    pub fn real_face(&self, f: u32) -> u32 {
+        match f.checked_sub(self.first_back) {
+            Some(k) => self.back_face.get(k as usize).copied().unwrap_or(f),
+            None => f,
+        }
+    }
+
+    /// Whether face id `f` is the back of a thin face.
+    pub fn is_back(&self, f: u32) -> bool {
+        f != NONE && self.real_face(f) != f
+    }
+
     /// The boundary edges of node `i` if it is a leaf (`set_boxes`), else none.
     pub fn leaf_edges(&self, i: usize) -> &[[DVec3; 2]] {
         &self.edges[self.edge_start[i] as usize..self.edge_start[i + 1] as usize]
     }
 
+    /// Index of the leaf node `n`.
     pub fn leaf_index(&self, n: &Node) -> usize {
         self.leaf_node[n.lo as usize] as usize
     }

@@ -15,12 +15,15 @@
 //! itself (`vertices`). Every step gives the same bits
 //! for any thread count.
 //!
-//! Parts of faces lying against another face (`covered`) neither shoot nor receive.
+//! Parts of faces lying against another face (`covered`) neither shoot nor receive. The
+//! backs of thin faces with something behind them are faces of their own in the hierarchy
+//! (`back`), which receive and shoot into the half-space behind.
 //!
 //! Settings: `convergence` sets both the link tolerance and the end of the solve;
 //! `visibility_rays` is the ray count for links carrying the most; `max_shots` caps the
 //! sweeps; `patch_size` is not used (the hierarchy replaces the grid patches).
 
+mod back;
 mod hierarchy;
 mod link;
 mod refine;
@@ -76,7 +79,11 @@ pub fn indirect(
     let faces = &scene.faces;
     let covers = crate::indirect::coplanar_contacts::covers(faces, 1e-6 * scene.diagonal());
     let leaf_radius = LEAF_RADIUS * settings.patch_size;
-    let mut h = Hierarchy::build(faces, el, |t| !covered(scene, el, &covers, t), leaf_radius);
+    // From here on, faces include the backs of thin faces (`back`).
+    let backs = back::Backs::new(scene, occ);
+    let faces: &[crate::scene::Face] = &backs.faces;
+    let keep = |t| !covered(scene, el, &covers, t);
+    let mut h = Hierarchy::build_two_sided(faces, el, keep, leaf_radius, &backs.of);
     h.set_boxes(faces, el);
     let nl = h.order.len();
     let mut result = IndirectResult {
@@ -88,7 +95,8 @@ pub fn indirect(
     };
     progress.check()?;
 
-    let leaves = leaf_inputs(scene, el, direct, &h);
+    let mut leaves = leaf_inputs(scene, el, direct, &h);
+    back::set_direct(scene, occ, el, &h, &mut leaves.direct, progress)?;
     let emitted_power: f64 = (0..nl)
         .map(|i| {
             let b = leaves.albedo[i] * leaves.direct[i] + leaves.emitted[i];

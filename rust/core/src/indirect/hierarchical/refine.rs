@@ -148,11 +148,12 @@ impl<'a> Refiner<'a> {
             let [a, b] = rn.kids;
             return self.split(&[(a, a), (a, b), (b, a), (b, b)], inherited, out);
         }
-        if rn.is_planar() && rn.face == sn.face {
+        // A face's front and back (`back`) see nothing of each other either.
+        let h = self.vis.h;
+        if rn.is_planar() && h.real_face(rn.face) == h.real_face(sn.face) {
             self.settle(rn, sn);
             return;
         }
-        let h = self.vis.h;
         let ends = Ends::new(h, self.vis.faces, r, s);
         // Wholly behind either plane: nothing passes.
         let behind = |n: &Node, plane_node: &Node, normal: Option<glam::DVec3>| {

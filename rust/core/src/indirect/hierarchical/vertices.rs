@@ -34,6 +34,10 @@ pub fn gathered(
     }
     let mut leaf_of = vec![NONE; nv];
     for (pos, &t) in h.order.iter().enumerate() {
+        // Backs of thin faces (`back`) share the front's triangles but not its vertices.
+        if h.is_back(h.nodes[h.leaf_node[pos] as usize].face) {
+            continue;
+        }
         for &v in &el.triangles[t as usize] {
             if leaf_of[v as usize] == NONE {
                 leaf_of[v as usize] = h.leaf_node[pos];

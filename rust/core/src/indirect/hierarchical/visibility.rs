@@ -33,7 +33,7 @@ impl Visibility<'_> {
         for n in [r, s] {
             if n.is_planar() {
                 planes.push(self.faces[n.face as usize].plane);
-                skip.push(n.face);
+                skip.push(self.h.real_face(n.face));
             }
         }
         (planes, skip)
@@ -105,7 +105,7 @@ impl Visibility<'_> {
         let skip: Vec<u32> = [r, s]
             .iter()
             .filter(|n| n.is_planar())
-            .map(|n| n.face)
+            .map(|n| self.h.real_face(n.face))
             .collect();
         let k = rays.max(1);
         // Only segments whose ends face each other carry light: on a cluster (a box), points
@@ -182,7 +182,9 @@ impl Visibility<'_> {
         if u + v > 1.0 {
             (u, v) = (1.0 - u, 1.0 - v);
         }
-        let normal = self.faces[self.el.tri_face[t] as usize].plane.n;
+        // The leaf's face, not the triangle's: a back leaf faces the other way.
+        let face = self.h.nodes[self.h.leaf_node[leaf as usize] as usize].face;
+        let normal = self.faces[face as usize].plane.n;
         (a * (1.0 - u - v) + b * u + c * v, normal)
     }
 }
