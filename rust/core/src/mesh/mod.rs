@@ -5,7 +5,9 @@
 //! contact shadows, point-light shadows) get two vertex rows, one per side.
 
 pub mod cancel;
+mod corner_split;
 pub mod elements;
+pub mod refine;
 pub mod sizing;
 
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -38,6 +40,12 @@ pub struct ReceiverMesh {
     pub triangles: Vec<[u32; 3]>,
     pub tri_region: Vec<u32>,
     pub regions: Vec<Region>,
+    /// Direct light per vertex when refinement computed it (else empty).
+    pub known_direct: Vec<Option<(DVec3, [u64; 3])>>,
+    /// Vertices where D0 edges end or turn (a box's foot corner): `corner_split` gives
+    /// each triangle there its own copy.
+    pub d0_corners: Vec<DVec2>,
+    pub refine: refine::RefineStats,
 }
 
 type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
@@ -45,7 +53,10 @@ type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
 /// Meshes one receiver. `budget` counts vertices over the whole scene so that a bake that
 /// would exceed `max_elements` stops early with a clear error. Evaluation points on D0 rows
 /// move at least `tol.d0_offset` off the line, so that the exact side tests of the light
-/// stages see them on their own side.
+/// stages see them on their own side. With `light`, elements are then refined until the
+/// direct light meets `settings.tolerance` (`refine`); the lattice is then seeded at the lit
+/// size everywhere, penumbrae included, and refinement finds where it must be finer.
+#[allow(clippy::too_many_arguments)]
 pub fn mesh_receiver(
     rr: &ReceiverRegions,
     sizing: &Sizing,
@@ -53,7 +64,9 @@ pub fn mesh_receiver(
     tol: &Tolerances,
     budget: &AtomicU64,
     progress: &crate::Progress,
+    light: Option<&refine::LightAt>,
 ) -> Result<ReceiverMesh, BakeError> {
+    let light = light.filter(|_| !settings.uniform);
     let arr = &rr.arrangement;
     let shift = shift_away_from_zero(&arr.vertices);
     let mut cdt = Cdt::new();
@@ -89,7 +102,9 @@ pub fn mesh_receiver(
     let mut seeds = Vec::new();
     for (f, rf) in arr.faces.iter().zip(&rr.faces) {
         progress.check()?;
-        let penumbra = !settings.uniform && rf.relations.iter().any(|r| *r == Relation::Penumbra);
+        let penumbra = !settings.uniform
+            && light.is_none()
+            && rf.relations.iter().any(|r| *r == Relation::Penumbra);
         let seen = |l: usize| rf.relations.get(l).is_some_and(|r| *r != Relation::Umbra);
         let size = |p: DVec2, reach: f64| {
             let s = if penumbra {
@@ -151,6 +166,21 @@ pub fn mesh_receiver(
         return Ok(m);
     }
     progress.check()?;
+    if let Some(light) = light {
+        let (mut m, stats) = refine::refine(
+            &mut cdt,
+            rr,
+            shift,
+            sizing.frame(),
+            settings,
+            tol,
+            light,
+            budget,
+            progress,
+        )?;
+        m.refine = stats;
+        return Ok(m);
+    }
     Ok(extract(&cdt, shift, rr, sizing.frame(), false, tol))
 }
 
@@ -412,6 +442,7 @@ fn extract(
             triangles,
             tri_region,
             regions: Vec::new(),
+            ..ReceiverMesh::default()
         };
     }
     let mut comp = vec![u32::MAX; faces.len()];
@@ -512,6 +543,7 @@ fn extract(
         }
     }
     let mut eval = positions.clone();
+    let mut d0_corners = Vec::new();
     d0_vertices.sort_unstable();
     d0_vertices.dedup();
     for vh in d0_vertices {
@@ -526,6 +558,19 @@ fn extract(
         let Some(first_cut) = (0..n).find(|&k| cut(k)) else {
             continue;
         };
+        let cuts: Vec<DVec2> = (0..n)
+            .filter(|&k| cut(k))
+            .map(|k| {
+                let q = out[k].to().position();
+                DVec2::new(q.x, q.y) - positions[vh.index()]
+            })
+            .collect();
+        let straight = cuts.len() == 2
+            && cuts[0].dot(cuts[1]) < 0.0
+            && cuts[0].perp_dot(cuts[1]).abs() <= 1e-9 * cuts[0].length() * cuts[1].length();
+        if !straight {
+            d0_corners.push(positions[vh.index()]);
+        }
         for s in 0..n {
             let k = (first_cut + s) % n;
             if s > 0 && cut(k) && !current.is_empty() {
@@ -595,6 +640,8 @@ fn extract(
         triangles,
         tri_region,
         regions,
+        d0_corners,
+        ..ReceiverMesh::default()
     }
 }
 

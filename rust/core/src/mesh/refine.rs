@@ -1,0 +1,387 @@
+//! A posteriori refinement to a tolerance on the direct light (issue 13). The exact direct
+//! light is cheap to evaluate anywhere (closed form where lit, the visible part of the light
+//! in penumbra, nothing in umbra), so after the conforming CDT each element is checked where
+//! linear interpolation errs most, at its edge midpoints and its centroid, and split where
+//! |interpolated − exact| > tolerance × (exact + floor). The floor, a fraction of the
+//! receiver's brightest value, keeps dark regions from refining without end. Splits insert
+//! points into the CDT, which keeps the D1/D0 constraint edges (a constraint edge is split
+//! into two constraint halves) and the Delaunay property (spade re-legalises around each new
+//! point). Nothing is split below the lower size bound.
+//!
+//! The light is handed in by the caller (`LightAt`), so the mesh stage does not reach into
+//! the direct stage; every value computed here is returned with the mesh and reused as the
+//! vertex's direct light.
+
+use std::collections::HashMap;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use glam::{DVec2, DVec3};
+use rayon::prelude::*;
+use spade::handles::FixedVertexHandle;
+use spade::{Point2, PositionInTriangulation, Triangulation};
+
+use super::{corner_split, extract, Cdt, ReceiverMesh};
+use crate::geom::Frame;
+use crate::regions::{ReceiverRegions, RegionFace};
+use crate::scene::settings::Settings;
+use crate::scene::Tolerances;
+use crate::BakeError;
+
+/// Direct irradiance at a point of the receiver (2-D frame) that lies in or on the border of
+/// the given regions, with its light counts (umbra skipped, lit, penumbra).
+pub type LightAt<'a> = dyn Fn(DVec2, &[&RegionFace]) -> (DVec3, [u64; 3]) + Sync + 'a;
+
+/// The floor of the error bound, as a fraction of the receiver's brightest vertex (per
+/// channel): an element is fine where its error is under tolerance × this much light.
+pub const FLOOR: f64 = 0.01;
+/// Elements are split when their error at a sample passes this fraction of the allowed
+/// error: the midpoints and centroid are where linear interpolation errs most for a smooth
+/// field, but not always, and the bound must hold at every point.
+pub const SAFETY: f64 = 0.4;
+/// Passes at most: each halves the elements that fail, so 30 passes span 2^30 in size.
+pub const MAX_PASSES: u32 = 30;
+/// The lower size bound as a fraction of `penumbra_element_size`.
+pub const LOWER_BOUND: f64 = 1.0 / 16.0;
+
+/// What refinement did on one receiver.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct RefineStats {
+    /// Passes that split at least one element.
+    pub passes: u64,
+    /// Vertices inserted by those passes.
+    pub vertices_added: u64,
+    /// Elements before the first pass and after the last.
+    pub elements_before: u64,
+    pub elements_after: u64,
+    /// Light evaluations (vertices, midpoints, centroids).
+    pub evaluations: u64,
+}
+
+/// The lower size bound for `settings`.
+pub fn lower_bound(settings: &Settings) -> f64 {
+    settings.penumbra_element_size * LOWER_BOUND
+}
+
+fn key(p: DVec2) -> [u64; 2] {
+    [p.x.to_bits(), p.y.to_bits()]
+}
+
+/// Refines `cdt` until every element meets `settings.tolerance` or the lower bound, and
+/// returns the element mesh (D0 rows and corners split) with the direct light known at
+/// every vertex.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn refine(
+    cdt: &mut Cdt,
+    rr: &ReceiverRegions,
+    frame: &Frame,
+    settings: &Settings,
+    tol: &Tolerances,
+    light: &LightAt,
+    budget: &AtomicU64,
+    progress: &crate::Progress,
+) -> Result<(ReceiverMesh, RefineStats), BakeError> {
+    let lower = lower_bound(settings);
+    let mut stats = RefineStats::default();
+    let mut cache: HashMap<[u64; 2], (DVec3, [u64; 3])> = HashMap::new();
+    loop {
+        progress.check()?;
+        let mut m = extract(cdt, rr, frame, false, tol);
+        corner_split::split(&mut m, &rr.d0_lines, tol);
+        let nv = m.positions.len();
+        if stats.passes == 0 {
+            stats.elements_before = m.triangles.len() as u64;
+        }
+
+        // Vertex values: each with the regions of the triangles around it (after the D0 and
+        // corner splits, only those of its own side).
+        let mut around: Vec<Vec<u32>> = vec![Vec::new(); nv];
+        for (t, tri) in m.triangles.iter().enumerate() {
+            for &v in tri {
+                let r = m.tri_region[t];
+                if !around[v as usize].contains(&r) {
+                    around[v as usize].push(r);
+                }
+            }
+        }
+        let missing: Vec<usize> = (0..nv)
+            .filter(|&v| !cache.contains_key(&key(m.eval[v])))
+            .collect();
+        let values: Vec<_> = missing
+            .par_iter()
+            .map(|&v| {
+                let regs: Vec<&RegionFace> =
+                    around[v].iter().map(|&r| &m.regions[r as usize]).collect();
+                light(m.eval[v], &regs)
+            })
+            .collect();
+        stats.evaluations += values.len() as u64;
+        for (&v, val) in missing.iter().zip(values) {
+            cache.insert(key(m.eval[v]), val);
+        }
+        progress.check()?;
+        let value = |v: u32| cache[&key(m.eval[v as usize])].0;
+        let floor = (0..nv as u32).map(value).fold(DVec3::ZERO, DVec3::max) * FLOOR;
+
+        let used = budget.load(Ordering::Relaxed);
+        if stats.passes >= MAX_PASSES as u64 || used >= settings.max_elements {
+            return Ok(finish(m, &cache, stats));
+        }
+
+        // Samples: edge midpoints (edges at least twice the lower bound) and centroids
+        // (elements whose edges are all splittable), at the mean of the evaluation points so
+        // that a sample beside a D0 row or a corner lies on its element's side.
+        let mut samples: Vec<Sample> = Vec::new();
+        for (t, tri) in m.triangles.iter().enumerate() {
+            let p = tri.map(|v| m.positions[v as usize]);
+            let mut splittable = 0;
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                if (p[k] - p[(k + 1) % 3]).length() < 2.0 * lower {
+                    continue;
+                }
+                splittable += 1;
+                samples.push(Sample {
+                    tri: t as u32,
+                    at: 0.5 * (m.eval[a as usize] + m.eval[b as usize]),
+                    interp: 0.5 * (value(a) + value(b)),
+                    split: Split::Edge(a, b),
+                });
+            }
+            if splittable == 3 {
+                let c = tri.map(|v| m.eval[v as usize]);
+                samples.push(Sample {
+                    tri: t as u32,
+                    at: (c[0] + c[1] + c[2]) / 3.0,
+                    interp: (value(tri[0]) + value(tri[1]) + value(tri[2])) / 3.0,
+                    split: Split::Centroid((p[0] + p[1] + p[2]) / 3.0),
+                });
+            }
+        }
+        let mut todo: Vec<(DVec2, u32)> = samples
+            .iter()
+            .filter(|s| !cache.contains_key(&key(s.at)))
+            .map(|s| (s.at, s.tri))
+            .collect();
+        todo.sort_unstable_by_key(|(p, _)| key(*p));
+        todo.dedup_by_key(|(p, _)| key(*p));
+        let values: Vec<_> = todo
+            .par_iter()
+            .map(|&(q, t)| light(q, &[&m.regions[m.tri_region[t as usize] as usize]]))
+            .collect();
+        stats.evaluations += values.len() as u64;
+        for (&(q, _), val) in todo.iter().zip(values) {
+            cache.insert(key(q), val);
+        }
+        progress.check()?;
+
+        let fails = |s: &Sample| {
+            let exact = cache[&key(s.at)].0;
+            let err = (s.interp - exact).abs();
+            let allowed = (exact.abs() + floor) * (settings.tolerance * SAFETY);
+            err.cmpgt(allowed).any()
+        };
+        let mut edges: Vec<(u32, u32)> = Vec::new();
+        let mut centroids: Vec<DVec2> = Vec::new();
+        let mut edge_failed = vec![false; m.triangles.len()];
+        for s in &samples {
+            if let Split::Edge(a, b) = s.split {
+                if fails(s) {
+                    edge_failed[s.tri as usize] = true;
+                    edges.push((a, b));
+                }
+            }
+        }
+        for s in &samples {
+            if let Split::Centroid(c) = s.split {
+                if !edge_failed[s.tri as usize] && fails(s) {
+                    centroids.push(c);
+                }
+            }
+        }
+        if edges.is_empty() && centroids.is_empty() {
+            return Ok(finish(m, &cache, stats));
+        }
+
+        // Back to the CDT's vertices: copies made by the D0 and corner splits stand for the
+        // CDT vertex at their position.
+        let handle_at: HashMap<[u64; 2], FixedVertexHandle> = cdt
+            .fixed_vertices()
+            .map(|h| {
+                let p = cdt.vertex(h).position();
+                (key(DVec2::new(p.x, p.y)), h)
+            })
+            .collect();
+        let mut pairs: Vec<(FixedVertexHandle, FixedVertexHandle)> = edges
+            .iter()
+            .filter_map(|&(a, b)| {
+                let ha = *handle_at.get(&key(m.positions[a as usize]))?;
+                let hb = *handle_at.get(&key(m.positions[b as usize]))?;
+                Some(if ha < hb { (ha, hb) } else { (hb, ha) })
+            })
+            .collect();
+        pairs.sort_unstable();
+        pairs.dedup();
+        // No Delaunay refinement for angles after the splits: spade's, run here, halves
+        // constraint edges near the rounding kinks of split constraints without end (on
+        // cornell it doubled the elements, 76k → 147k, and left more thin triangles).
+        let before = cdt.num_vertices();
+        let room = settings.max_elements.saturating_sub(used) as usize;
+        for (k, &(a, b)) in pairs.iter().enumerate() {
+            if k % 1024 == 0 {
+                progress.check()?;
+            }
+            if cdt.num_vertices() - before >= room {
+                break;
+            }
+            split_edge(cdt, a, b);
+        }
+        for c in centroids {
+            if cdt.num_vertices() - before >= room {
+                break;
+            }
+            insert_inside(cdt, Point2::new(c.x, c.y), None);
+        }
+        let added = (cdt.num_vertices() - before) as u64;
+        budget.fetch_add(added, Ordering::Relaxed);
+        stats.passes += 1;
+        stats.vertices_added += added;
+        if added == 0 {
+            return Ok(finish(extract_split(cdt, rr, frame, tol), &cache, stats));
+        }
+    }
+}
+
+fn extract_split(cdt: &Cdt, rr: &ReceiverRegions, frame: &Frame, tol: &Tolerances) -> ReceiverMesh {
+    let mut m = extract(cdt, rr, frame, false, tol);
+    corner_split::split(&mut m, &rr.d0_lines, tol);
+    m
+}
+
+/// The mesh with the values known at its vertices.
+fn finish(
+    mut m: ReceiverMesh,
+    cache: &HashMap<[u64; 2], (DVec3, [u64; 3])>,
+    mut stats: RefineStats,
+) -> (ReceiverMesh, RefineStats) {
+    stats.elements_after = m.triangles.len() as u64;
+    m.known_direct = m
+        .eval
+        .iter()
+        .map(|p| cache.get(&key(*p)).copied())
+        .collect();
+    (m, stats)
+}
+
+struct Sample {
+    tri: u32,
+    /// Where the light is evaluated.
+    at: DVec2,
+    /// The element's linear interpolant there.
+    interp: DVec3,
+    split: Split,
+}
+
+enum Split {
+    /// Element vertices of the edge.
+    Edge(u32, u32),
+    /// Where to insert a vertex.
+    Centroid(DVec2),
+}
+
+/// `p` moved towards `c` by the least of a few growing steps that brings it inside the
+/// triangulation's hull, or `None`.
+fn inwards(cdt: &Cdt, p: Point2<f64>, c: Point2<f64>) -> Option<Point2<f64>> {
+    let mut t = 1e-12;
+    for _ in 0..8 {
+        let q = Point2::new(p.x + (c.x - p.x) * t, p.y + (c.y - p.y) * t);
+        if !matches!(
+            cdt.locate(q),
+            PositionInTriangulation::OutsideOfConvexHull(_)
+        ) {
+            return Some(q);
+        }
+        t *= 10.0;
+    }
+    None
+}
+
+/// Inserts `p`, never outside the hull (the receiver): a point that rounding put outside
+/// moves a hair towards `towards`, or is left out.
+fn insert_inside(cdt: &mut Cdt, p: Point2<f64>, towards: Option<Point2<f64>>) {
+    let q = match cdt.locate(p) {
+        PositionInTriangulation::OutsideOfConvexHull(_) => match towards {
+            Some(c) => inwards(cdt, p, c),
+            None => None,
+        },
+        _ => Some(p),
+    };
+    if let Some(q) = q {
+        let _ = cdt.insert(q);
+    }
+}
+
+/// Splits the CDT edge `a`–`b` at its midpoint. A constraint edge stays a constraint in two
+/// halves. The rounded midpoint mostly lies a hair off the exact line, where spade would
+/// leave the edge whole; then it lies inside a triangle on the edge, so the constraint is
+/// lifted, the point inserted, and the halves (inside that triangle: no other constraint
+/// can cross them) constrained. Anywhere else (a needle edge) the edge is left whole.
+fn split_edge(cdt: &mut Cdt, a: FixedVertexHandle, b: FixedVertexHandle) {
+    let (pa, pb) = (cdt.vertex(a).position(), cdt.vertex(b).position());
+    let mid = Point2::new(0.5 * (pa.x + pb.x), 0.5 * (pa.y + pb.y));
+    let Some(e) = cdt.get_edge_from_neighbors(a, b).map(|e| e.fix()) else {
+        // Flipped away by an earlier split of this pass: the region still wants a vertex.
+        insert_inside(cdt, mid, None);
+        return;
+    };
+    if !cdt.is_constraint_edge(e.as_undirected()) {
+        let inner = cdt.directed_edge(e).opposite_position();
+        insert_inside(cdt, mid, inner);
+        return;
+    }
+    // On the receiver's boundary the rounded midpoint may fall outside: a hair inwards.
+    let edge = cdt.directed_edge(e);
+    let inner = edge
+        .opposite_position()
+        .or_else(|| edge.rev().opposite_position());
+    let mid = match (cdt.locate(mid), inner) {
+        (PositionInTriangulation::OutsideOfConvexHull(_), Some(c)) => match inwards(cdt, mid, c) {
+            Some(q) => q,
+            None => return,
+        },
+        _ => mid,
+    };
+    let beside = match cdt.locate(mid) {
+        PositionInTriangulation::OnEdge(on) => {
+            if on.as_undirected() == e.as_undirected() {
+                // Exactly on the line: spade splits the constraint itself.
+                let _ = cdt.insert(mid);
+            }
+            return;
+        }
+        PositionInTriangulation::OnFace(f) => {
+            let edge = cdt.directed_edge(e);
+            [edge.face(), edge.rev().face()]
+                .iter()
+                .any(|g| g.as_inner().is_some_and(|g| g.fix() == f))
+        }
+        _ => false,
+    };
+    if !beside {
+        return;
+    }
+    cdt.remove_constraint_edge(e.as_undirected());
+    match cdt.insert(mid) {
+        Ok(h) if h != a && h != b => {
+            for (x, y) in [(a, h), (h, b)] {
+                if cdt.can_add_constraint(x, y) {
+                    cdt.add_constraint(x, y);
+                }
+            }
+        }
+        _ => {
+            if cdt.can_add_constraint(a, b) {
+                cdt.add_constraint(a, b);
+            }
+        }
+    }
+}
