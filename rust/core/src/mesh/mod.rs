@@ -112,7 +112,13 @@ pub fn mesh_receiver(
             } else {
                 sizing.lit(p, reach, &seen)
             };
-            corners.cap(s, p, reach)
+            // Refinement finds what the corners need (and `corner_split` gives each
+            // triangle there its own value): no grading towards them beforehand.
+            if light.is_some() {
+                s
+            } else {
+                corners.cap(s, p, reach)
+            }
         };
         graded_lattice(&arr.vertices, f, &size, &mut seeds);
     }
