@@ -270,7 +270,7 @@ fn argument_errors_are_one_line_and_exit_2() {
 #[test]
 fn tolerance_flag_checked_like_the_setting() {
     let p = write("tolerance.json", GOOD);
-    for t in ["0", "-0.1", "2", "NaN"] {
+    for t in ["0", "2", "NaN"] {
         let out = penumbra()
             .args([
                 "bake",

@@ -239,7 +239,7 @@ pub(crate) fn refine(
             if cdt.num_vertices() - before >= room {
                 break;
             }
-            insert_inside(cdt, Point2::new(c.x, c.y), None);
+            insert_inside(cdt, Point2::new(c.x, c.y));
         }
         let added = (cdt.num_vertices() - before) as u64;
         budget.fetch_add(added, Ordering::Relaxed);
@@ -288,35 +288,13 @@ enum Split {
     Centroid(DVec2),
 }
 
-/// `p` moved towards `c` by the least of a few growing steps that brings it inside the
-/// triangulation's hull, or `None`.
-fn inwards(cdt: &Cdt, p: Point2<f64>, c: Point2<f64>) -> Option<Point2<f64>> {
-    let mut t = 1e-12;
-    for _ in 0..8 {
-        let q = Point2::new(p.x + (c.x - p.x) * t, p.y + (c.y - p.y) * t);
-        if !matches!(
-            cdt.locate(q),
-            PositionInTriangulation::OutsideOfConvexHull(_)
-        ) {
-            return Some(q);
-        }
-        t *= 10.0;
-    }
-    None
-}
-
-/// Inserts `p`, never outside the hull (the receiver): a point that rounding put outside
-/// moves a hair towards `towards`, or is left out.
-fn insert_inside(cdt: &mut Cdt, p: Point2<f64>, towards: Option<Point2<f64>>) {
-    let q = match cdt.locate(p) {
-        PositionInTriangulation::OutsideOfConvexHull(_) => match towards {
-            Some(c) => inwards(cdt, p, c),
-            None => None,
-        },
-        _ => Some(p),
-    };
-    if let Some(q) = q {
-        let _ = cdt.insert(q);
+/// Inserts `p` unless rounding put it outside the hull (the receiver).
+fn insert_inside(cdt: &mut Cdt, p: Point2<f64>) {
+    if !matches!(
+        cdt.locate(p),
+        PositionInTriangulation::OutsideOfConvexHull(_)
+    ) {
+        let _ = cdt.insert(p);
     }
 }
 
@@ -330,26 +308,18 @@ fn split_edge(cdt: &mut Cdt, a: FixedVertexHandle, b: FixedVertexHandle) {
     let mid = Point2::new(0.5 * (pa.x + pb.x), 0.5 * (pa.y + pb.y));
     let Some(e) = cdt.get_edge_from_neighbors(a, b).map(|e| e.fix()) else {
         // Flipped away by an earlier split of this pass: the region still wants a vertex.
-        insert_inside(cdt, mid, None);
+        insert_inside(cdt, mid);
         return;
     };
     if !cdt.is_constraint_edge(e.as_undirected()) {
-        let inner = cdt.directed_edge(e).opposite_position();
-        insert_inside(cdt, mid, inner);
+        insert_inside(cdt, mid);
         return;
     }
-    // On the receiver's boundary the rounded midpoint may fall outside: a hair inwards.
-    let edge = cdt.directed_edge(e);
-    let inner = edge
-        .opposite_position()
-        .or_else(|| edge.rev().opposite_position());
-    let mid = match (cdt.locate(mid), inner) {
-        (PositionInTriangulation::OutsideOfConvexHull(_), Some(c)) => match inwards(cdt, mid, c) {
-            Some(q) => q,
-            None => return,
-        },
-        _ => mid,
-    };
+    // A rounded midpoint outside the hull (the receiver's boundary) is left out: moved
+    // inwards it would leave a sliver against the boundary whose facing rounding decides.
+    if let PositionInTriangulation::OutsideOfConvexHull(_) = cdt.locate(mid) {
+        return;
+    }
     let beside = match cdt.locate(mid) {
         PositionInTriangulation::OnEdge(on) => {
             if on.as_undirected() == e.as_undirected() {
