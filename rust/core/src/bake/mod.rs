@@ -215,7 +215,15 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
             // The exact direct light, for refinement to the tolerance.
             let face = rr.face;
             let light = |q: glam::DVec2, regs: &[&regions::Region]| {
-                direct::light_at(scene, &tol, face, f.frame.to_3d(q), f.plane.n, regs, &outlines)
+                direct::light_at(
+                    scene,
+                    &tol,
+                    face,
+                    f.frame.to_3d(q),
+                    f.plane.n,
+                    regs,
+                    &outlines,
+                )
             };
             mesh::mesh_receiver(rr, &sizing, settings, &tol, &budget, progress, Some(&light))
         })

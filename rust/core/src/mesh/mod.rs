@@ -6,6 +6,7 @@
 
 pub mod cancel;
 mod corner_split;
+mod doubt;
 pub mod elements;
 pub mod refine;
 pub mod sizing;
@@ -150,15 +151,11 @@ pub fn mesh_receiver(
     let fine_area = 0.433 * fine * fine;
     let extra =
         (settings.max_elements.saturating_sub(used) as usize).min(cdt.num_vertices() * 4 + 64);
-    cancel::refine_in_rounds(
-        &mut cdt,
-        RefinementParameters::new()
-            .with_angle_limit(AngleLimit::from_deg(settings.min_angle))
-            .with_max_allowed_area(coarse_area * 1.5)
-            .with_min_required_area(fine_area * if dense { DENSE_MIN_AREA } else { 0.02 }),
-        extra,
-        progress,
-    )?;
+    let angles = RefinementParameters::new()
+        .with_angle_limit(AngleLimit::from_deg(settings.min_angle))
+        .with_max_allowed_area(coarse_area * 1.5)
+        .with_min_required_area(fine_area * if dense { DENSE_MIN_AREA } else { 0.02 });
+    cancel::refine_in_rounds(&mut cdt, angles.clone(), extra, progress)?;
     budget.fetch_add(
         cdt.num_vertices() as u64 - inserted as u64,
         Ordering::Relaxed,

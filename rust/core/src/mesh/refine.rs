@@ -20,16 +20,18 @@ use rayon::prelude::*;
 use spade::handles::FixedVertexHandle;
 use spade::{Point2, PositionInTriangulation, Triangulation};
 
-use super::{corner_split, extract, Cdt, ReceiverMesh};
+use super::{corner_split, doubt, extract, Cdt, ReceiverMesh};
+use crate::geom::polygon::orient;
 use crate::geom::Frame;
-use crate::regions::{ReceiverRegions, RegionFace};
+use crate::regions::relation::Relation;
+use crate::regions::{ReceiverRegions, Region};
 use crate::scene::settings::Settings;
 use crate::scene::Tolerances;
 use crate::BakeError;
 
 /// Direct irradiance at a point of the receiver (2-D frame) that lies in or on the border of
 /// the given regions, with its light counts (umbra skipped, lit, penumbra).
-pub type LightAt<'a> = dyn Fn(DVec2, &[&RegionFace]) -> (DVec3, [u64; 3]) + Sync + 'a;
+pub type LightAt<'a> = dyn Fn(DVec2, &[&Region]) -> (DVec3, [u64; 3]) + Sync + 'a;
 
 /// The floor of the error bound, as a fraction of the receiver's brightest vertex (per
 /// channel): an element is fine where its error is under tolerance × this much light.
@@ -73,6 +75,7 @@ fn key(p: DVec2) -> [u64; 2] {
 pub(crate) fn refine(
     cdt: &mut Cdt,
     rr: &ReceiverRegions,
+    shift: DVec2,
     frame: &Frame,
     settings: &Settings,
     tol: &Tolerances,
@@ -85,7 +88,7 @@ pub(crate) fn refine(
     let mut cache: HashMap<[u64; 2], (DVec3, [u64; 3])> = HashMap::new();
     loop {
         progress.check()?;
-        let mut m = extract(cdt, rr, frame, false, tol);
+        let mut m = extract(cdt, shift, rr, frame, false, tol);
         corner_split::split(&mut m, &rr.d0_lines, tol);
         let nv = m.positions.len();
         if stats.passes == 0 {
@@ -109,7 +112,7 @@ pub(crate) fn refine(
         let values: Vec<_> = missing
             .par_iter()
             .map(|&v| {
-                let regs: Vec<&RegionFace> =
+                let regs: Vec<&Region> =
                     around[v].iter().map(|&r| &m.regions[r as usize]).collect();
                 light(m.eval[v], &regs)
             })
@@ -130,8 +133,27 @@ pub(crate) fn refine(
         // Samples: edge midpoints (edges at least twice the lower bound) and centroids
         // (elements whose edges are all splittable), at the mean of the evaluation points so
         // that a sample beside a D0 row or a corner lies on its element's side.
+        // Checked exactly only where the vertex values leave the element in doubt.
+        let allowed = |t: usize| {
+            let least = m.triangles[t]
+                .iter()
+                .map(|&v| value(v).abs())
+                .fold(DVec3::splat(f64::INFINITY), DVec3::min);
+            (least + floor) * (settings.tolerance * SAFETY)
+        };
+        let doubtful = doubt::doubtful(&m.positions, &m.triangles, &m.tri_region, &value, &allowed);
         let mut samples: Vec<Sample> = Vec::new();
         for (t, tri) in m.triangles.iter().enumerate() {
+            if !doubtful[t] {
+                continue;
+            }
+            // In umbra of every light the exact light is nothing, and so are the vertices
+            // (those on its border lie where the light comes in continuously, from nothing,
+            // or on a D0 row whose copy on this side is dark): nothing to check.
+            let region = &m.regions[m.tri_region[t] as usize];
+            if region.relations.iter().all(|r| *r == Relation::Umbra) {
+                continue;
+            }
             let p = tri.map(|v| m.positions[v as usize]);
             let mut splittable = 0;
             for k in 0..3 {
@@ -208,22 +230,21 @@ pub(crate) fn refine(
             .fixed_vertices()
             .map(|h| {
                 let p = cdt.vertex(h).position();
-                (key(DVec2::new(p.x, p.y)), h)
+                (key(DVec2::new(p.x, p.y) - shift), h)
             })
             .collect();
+        // Directed as in their triangle (counter-clockwise), so that the triangle that failed
+        // lies on the left.
         let mut pairs: Vec<(FixedVertexHandle, FixedVertexHandle)> = edges
             .iter()
             .filter_map(|&(a, b)| {
                 let ha = *handle_at.get(&key(m.positions[a as usize]))?;
                 let hb = *handle_at.get(&key(m.positions[b as usize]))?;
-                Some(if ha < hb { (ha, hb) } else { (hb, ha) })
+                (ha != hb).then_some((ha, hb))
             })
             .collect();
         pairs.sort_unstable();
         pairs.dedup();
-        // No Delaunay refinement for angles after the splits: spade's, run here, halves
-        // constraint edges near the rounding kinks of split constraints without end (on
-        // cornell it doubled the elements, 76k → 147k, and left more thin triangles).
         let before = cdt.num_vertices();
         let room = settings.max_elements.saturating_sub(used) as usize;
         for (k, &(a, b)) in pairs.iter().enumerate() {
@@ -239,6 +260,7 @@ pub(crate) fn refine(
             if cdt.num_vertices() - before >= room {
                 break;
             }
+            let c = c + shift;
             insert_inside(cdt, Point2::new(c.x, c.y));
         }
         let added = (cdt.num_vertices() - before) as u64;
@@ -246,13 +268,23 @@ pub(crate) fn refine(
         stats.passes += 1;
         stats.vertices_added += added;
         if added == 0 {
-            return Ok(finish(extract_split(cdt, rr, frame, tol), &cache, stats));
+            return Ok(finish(
+                extract_split(cdt, shift, rr, frame, tol),
+                &cache,
+                stats,
+            ));
         }
     }
 }
 
-fn extract_split(cdt: &Cdt, rr: &ReceiverRegions, frame: &Frame, tol: &Tolerances) -> ReceiverMesh {
-    let mut m = extract(cdt, rr, frame, false, tol);
+fn extract_split(
+    cdt: &Cdt,
+    shift: DVec2,
+    rr: &ReceiverRegions,
+    frame: &Frame,
+    tol: &Tolerances,
+) -> ReceiverMesh {
+    let mut m = extract(cdt, shift, rr, frame, false, tol);
     corner_split::split(&mut m, &rr.d0_lines, tol);
     m
 }
@@ -298,11 +330,9 @@ fn insert_inside(cdt: &mut Cdt, p: Point2<f64>) {
     }
 }
 
-/// Splits the CDT edge `a`–`b` at its midpoint. A constraint edge stays a constraint in two
-/// halves. The rounded midpoint mostly lies a hair off the exact line, where spade would
-/// leave the edge whole; then it lies inside a triangle on the edge, so the constraint is
-/// lifted, the point inserted, and the halves (inside that triangle: no other constraint
-/// can cross them) constrained. Anywhere else (a needle edge) the edge is left whole.
+/// Splits the CDT edge `a`→`b` (the failed triangle on its left) near its midpoint. An
+/// edge inside a region takes the midpoint as a new vertex. A constraint (a D1/D0 edge) or
+/// a boundary edge is split by the triangulation itself (`split_constraint`).
 fn split_edge(cdt: &mut Cdt, a: FixedVertexHandle, b: FixedVertexHandle) {
     let (pa, pb) = (cdt.vertex(a).position(), cdt.vertex(b).position());
     let mid = Point2::new(0.5 * (pa.x + pb.x), 0.5 * (pa.y + pb.y));
@@ -311,47 +341,53 @@ fn split_edge(cdt: &mut Cdt, a: FixedVertexHandle, b: FixedVertexHandle) {
         insert_inside(cdt, mid);
         return;
     };
-    if !cdt.is_constraint_edge(e.as_undirected()) {
+    let edge = cdt.directed_edge(e);
+    if !edge.is_constraint_edge() && !edge.as_undirected().is_part_of_convex_hull() {
         insert_inside(cdt, mid);
         return;
     }
-    // A rounded midpoint outside the hull (the receiver's boundary) is left out: moved
-    // inwards it would leave a sliver against the boundary whose facing rounding decides.
-    if let PositionInTriangulation::OutsideOfConvexHull(_) = cdt.locate(mid) {
+    split_constraint(cdt, e);
+}
+
+/// Splits a constraint or boundary edge in the triangulation's own structure. Inserted as a
+/// point, its rounded midpoint lies a hair off the line, and the constraint put back through
+/// it leaves a sliver between the line and the point, or a triangle that rounding turns
+/// over (tests/mesh_validity.rs). spade splits an existing constraint in place only where
+/// a new constraint crosses it: so a constraint is drawn from the vertex opposite the edge
+/// on one side to the one on the other (for a boundary edge, to a point put outside for
+/// the moment, the opposite vertex mirrored through the midpoint), which splits the edge
+/// where it crosses; the drawn constraint is then unmarked (and the outside point
+/// removed), and the edge's halves stay one constraint line.
+fn split_constraint(cdt: &mut Cdt, e: spade::handles::FixedDirectedEdgeHandle) {
+    let edge = cdt.directed_edge(e);
+    let (a, b) = (edge.from().position(), edge.to().position());
+    let Some(c) = edge.opposite_vertex().map(|v| v.fix()) else {
         return;
-    }
-    let beside = match cdt.locate(mid) {
-        PositionInTriangulation::OnEdge(on) => {
-            if on.as_undirected() == e.as_undirected() {
-                // Exactly on the line: spade splits the constraint itself.
-                let _ = cdt.insert(mid);
-            }
-            return;
-        }
-        PositionInTriangulation::OnFace(f) => {
-            let edge = cdt.directed_edge(e);
-            [edge.face(), edge.rev().face()]
-                .iter()
-                .any(|g| g.as_inner().is_some_and(|g| g.fix() == f))
-        }
-        _ => false,
     };
-    if !beside {
-        return;
+    let pc = cdt.vertex(c).position();
+    let p2 = |p: Point2<f64>| DVec2::new(p.x, p.y);
+    let (da, db) = (p2(a), p2(b));
+    let crosses = |from: DVec2, to: DVec2| {
+        let (sa, sb) = (orient(from, to, da), orient(from, to, db));
+        (sa > 0.0 && sb < 0.0) || (sa < 0.0 && sb > 0.0)
+    };
+    let (d, temporary) = match edge.rev().opposite_vertex().map(|v| v.fix()) {
+        Some(d) => (d, false),
+        None => {
+            let m = 0.5 * (da + db);
+            let t = 2.0 * m - p2(pc);
+            match cdt.insert(Point2::new(t.x, t.y)) {
+                Ok(h) if h.index() + 1 == cdt.num_vertices() => (h, true),
+                _ => return,
+            }
+        }
+    };
+    if crosses(p2(pc), p2(cdt.vertex(d).position())) {
+        for drawn in cdt.add_constraint_and_split(c, d, |p| p) {
+            cdt.remove_constraint_edge(drawn.as_undirected());
+        }
     }
-    cdt.remove_constraint_edge(e.as_undirected());
-    match cdt.insert(mid) {
-        Ok(h) if h != a && h != b => {
-            for (x, y) in [(a, h), (h, b)] {
-                if cdt.can_add_constraint(x, y) {
-                    cdt.add_constraint(x, y);
-                }
-            }
-        }
-        _ => {
-            if cdt.can_add_constraint(a, b) {
-                cdt.add_constraint(a, b);
-            }
-        }
+    if temporary {
+        cdt.remove(d);
     }
 }
