@@ -42,6 +42,10 @@ pub const FLOOR: f64 = 0.01;
 pub const SAFETY: f64 = 0.4;
 /// Passes at most: each halves the elements that fail, so 30 passes span 2^30 in size.
 pub const MAX_PASSES: u32 = 30;
+/// Refinement stops after a pass that added fewer vertices than the elements over this
+/// (and than `TAIL_MIN`).
+pub const TAIL_FRACTION: u64 = 1000;
+pub const TAIL_MIN: u64 = 8;
 /// The lower size bound as a fraction of `penumbra_element_size`.
 pub const LOWER_BOUND: f64 = 1.0 / 16.0;
 
@@ -267,7 +271,11 @@ pub(crate) fn refine(
         budget.fetch_add(added, Ordering::Relaxed);
         stats.passes += 1;
         stats.vertices_added += added;
-        if added == 0 {
+        // A pass costs a whole extraction of the receiver; once passes only add a handful
+        // of vertices (the last elements at a D0 corner or a kink halving down to the lower
+        // bound), the tail is not worth its passes: this pass's points are the last.
+        let tail = (m.triangles.len() as u64 / TAIL_FRACTION).max(TAIL_MIN);
+        if added < tail {
             return Ok(finish(
                 extract_split(cdt, shift, rr, frame, tol),
                 &cache,
