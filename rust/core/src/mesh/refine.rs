@@ -46,6 +46,8 @@ pub const MAX_PASSES: u32 = 30;
 /// (and than `TAIL_MIN`).
 pub const TAIL_FRACTION: u64 = 1000;
 pub const TAIL_MIN: u64 = 8;
+/// A triangle lower than this fraction of an edge is flat: its edges are not split.
+pub const FLAT: f64 = 1e-3;
 /// The lower size bound as a fraction of `penumbra_element_size`.
 pub const LOWER_BOUND: f64 = 1.0 / 16.0;
 
@@ -351,6 +353,25 @@ fn split_edge(cdt: &mut Cdt, a: FixedVertexHandle, b: FixedVertexHandle) {
     };
     let edge = cdt.directed_edge(e);
     if !edge.is_constraint_edge() && !edge.as_undirected().is_part_of_convex_hull() {
+        // An edge of a flat triangle (three points of one kinked constraint line, spanned
+        // by the triangulation): its midpoint lies on that line to within rounding, and
+        // would cut slivers that rounding may turn over (tests/mesh_validity.rs).
+        let len = DVec2::new(pb.x - pa.x, pb.y - pa.y).length();
+        let flat = [edge, edge.rev()].iter().any(|side| {
+            side.opposite_position().is_some_and(|c| {
+                let h = orient(
+                    DVec2::new(pa.x, pa.y),
+                    DVec2::new(pb.x, pb.y),
+                    DVec2::new(c.x, c.y),
+                )
+                .abs()
+                    / len.max(f64::MIN_POSITIVE);
+                h < FLAT * len
+            })
+        });
+        if flat {
+            return;
+        }
         insert_inside(cdt, mid);
         return;
     }
@@ -362,10 +383,8 @@ fn split_edge(cdt: &mut Cdt, a: FixedVertexHandle, b: FixedVertexHandle) {
 /// it leaves a sliver between the line and the point, or a triangle that rounding turns
 /// over (tests/mesh_validity.rs). spade splits an existing constraint in place only where
 /// a new constraint crosses it: so a constraint is drawn from the vertex opposite the edge
-/// on one side to the one on the other (for a boundary edge, to a point put outside for
-/// the moment, the opposite vertex mirrored through the midpoint), which splits the edge
-/// where it crosses; the drawn constraint is then unmarked (and the outside point
-/// removed), and the edge's halves stay one constraint line.
+/// on one side to the one on the other, which splits the edge where it crosses; the drawn
+/// constraint is then unmarked, and the edge's halves stay one constraint line.
 fn split_constraint(cdt: &mut Cdt, e: spade::handles::FixedDirectedEdgeHandle) {
     let edge = cdt.directed_edge(e);
     let (a, b) = (edge.from().position(), edge.to().position());
@@ -379,23 +398,27 @@ fn split_constraint(cdt: &mut Cdt, e: spade::handles::FixedDirectedEdgeHandle) {
         let (sa, sb) = (orient(from, to, da), orient(from, to, db));
         (sa > 0.0 && sb < 0.0) || (sa < 0.0 && sb > 0.0)
     };
-    let (d, temporary) = match edge.rev().opposite_vertex().map(|v| v.fix()) {
-        Some(d) => (d, false),
-        None => {
-            let m = 0.5 * (da + db);
-            let t = 2.0 * m - p2(pc);
-            match cdt.insert(Point2::new(t.x, t.y)) {
-                Ok(h) if h.index() + 1 == cdt.num_vertices() => (h, true),
-                _ => return,
-            }
-        }
+    // A boundary edge has no vertex beyond it to draw to: it is left whole (its elements
+    // are refined from inside only).
+    let Some(d) = edge.rev().opposite_vertex().map(|v| v.fix()) else {
+        return;
     };
-    if crosses(p2(pc), p2(cdt.vertex(d).position())) {
+    let pd = p2(cdt.vertex(d).position());
+    // Where the drawn constraint crosses, as a fraction of the edge: near an end it would
+    // leave a needle of a triangle.
+    let (u, w) = (db - da, pd - p2(pc));
+    let den = u.perp_dot(w);
+    let at = if den != 0.0 {
+        (p2(pc) - da).perp_dot(w) / den
+    } else {
+        -1.0
+    };
+    if !(0.2..=0.8).contains(&at) {
+        return;
+    }
+    if crosses(p2(pc), pd) {
         for drawn in cdt.add_constraint_and_split(c, d, |p| p) {
             cdt.remove_constraint_edge(drawn.as_undirected());
         }
-    }
-    if temporary {
-        cdt.remove(d);
     }
 }
