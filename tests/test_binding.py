@@ -122,14 +122,16 @@ def test_nothing_to_bake():
 
 
 def test_tolerance_setting_refines_and_is_checked():
-    # A tighter tolerance gives more elements, each refinement pass counted (issue 13).
-    counts = []
+    # A tighter tolerance gives more elements, each refinement pass counted (issue 13). At
+    # 3 % the starting lattice already meets it on this smooth field (no pass splits).
+    counts, passes = [], []
     for tol in (0.03, 0.001):
         scene = plane_under_square_light()
         scene["settings"]["tolerance"] = tol
         stats = _core.bake(scene)["stats"]
         counts.append(stats["N_e"])
-        assert stats["refine_passes"] >= 1
+        passes.append(stats["refine_passes"])
+    assert passes[1] >= 1 and passes[1] >= passes[0]
     assert counts[1] > counts[0]
     scene = plane_under_square_light()
     scene["settings"]["tolerance"] = 0.0
