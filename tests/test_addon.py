@@ -301,6 +301,22 @@ def test_bake_the_room_with_default_settings(room_scene, empty):
     assert np.allclose(co[:, :2].min(axis=0), [-2, -2]) and np.allclose(co[:, :2].max(axis=0), [2, 2])
 
 
+def test_the_hierarchical_solver_is_chosen_from_the_panel(room_scene, empty):
+    # The setting reaches the core (which refuses a solver it does not know), and both
+    # solvers bake the room: the ceiling gets only bounced light, and the two agree on it
+    # as a whole (each is checked against closed forms and Cycles in the core's tests).
+    empty.scene.penumbra.quality = "DRAFT"
+    means = {}
+    for solver in ("PROGRESSIVE", "HIERARCHICAL"):
+        empty.scene.penumbra.indirect_solver = solver
+        ex = export_scene(empty, empty.scene.penumbra)
+        assert ex.scene["settings"]["indirect_solver"] == solver.lower()
+        assert bpy.ops.penumbra.bake() == {"FINISHED"}
+        _, rgb = _colors(bpy.data.objects["Ceiling_baked"])
+        means[solver] = rgb.mean()
+    assert abs(means["HIERARCHICAL"] / means["PROGRESSIVE"] - 1) < 0.05, means
+
+
 def test_hide_originals_and_rebake(room_scene, empty):
     empty.scene.penumbra.hide_originals = True
     assert bpy.ops.penumbra.bake() == {"FINISHED"}

@@ -20,7 +20,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.dirname(HERE))
 
-from bench_lib import errors, lightmap, penumbra_job, probes, report, uniform_cycles  # noqa: E402
+from bench_lib import errors, lightmap, penumbra_job, probes, report, solvers, uniform_cycles  # noqa: E402
 
 # Full scenes compared with Cycles (built-in scenes of the CLI). room-78 is the scaling
 # room with 78 boxes of clutter (60 + 12·78 = 996 furniture triangles).
@@ -42,6 +42,9 @@ class Config:
         # A scaling bake that runs longer is stopped and reported as over the limit; the
         # larger sizes are then not attempted.
         self.scaling_timeout = 40 if quick else 200
+        # Both indirect solvers on full bakes (--solvers-only): long enough for the
+        # hierarchical solver on room-245.
+        self.solver_timeout = 150 if quick else 400
         # room-78 (1k triangles) takes most of the quick budget: full suite only.
         self.scenes = SCENES[:4] if quick else SCENES
         self.render_res = 120 if quick else 200
@@ -351,6 +354,10 @@ def main():
     ap.add_argument("--tolerance", action="store_true",
                     help="only direct light refined to tolerances 3 %%…0.1 %% against uniform "
                     "meshes, and room-8328 direct-only (bench_lib/tolerance.py)")
+    ap.add_argument("--solvers-only", action="store_true",
+                    help="only the two indirect solvers on full bakes (default scenes plus "
+                    "room-245; --quick: the first four); writes OUT/solvers.json and its section "
+                    "of OUT/results.md and README.md")
     a = ap.parse_args()
     if a.report_only and a.lightmap_only:
         with open(os.path.join(a.out, "lightmaps.json")) as f:
@@ -395,6 +402,16 @@ def main():
         rows = [uniform_cycles.bench_scene(n, a.exe, sys.executable, a.work, cfg)
                 for n in a.scenes]
         write_uniform(rows, machine(), command, a.out)
+        return
+    if a.solvers_only:
+        names = a.scenes if a.scenes != cfg.scenes else cfg.scenes + ([] if a.quick else ["room-245"])
+        command += " --solvers-only" + (f" --scenes {' '.join(names)}" if a.scenes != cfg.scenes
+                                        else "")
+        rows = [solvers.bench_scene(n, a.exe, sys.executable, a.work, cfg, cfg.solver_timeout)
+                for n in names]
+        mach = machine()
+        write_section("solvers", rows, solvers.section(rows, mach, command), mach, command,
+                      a.out, solvers.START, solvers.END)
         return
     res = dict(machine=machine(), quick=a.quick, config=vars(cfg), command=command, scenes={})
     res["lightmaps"] = []

@@ -65,8 +65,17 @@ class PenumbraSettings(bpy.types.PropertyGroup):
     )
     use_indirect: BoolProperty(
         name="Indirect Light",
-        description="Add light bounced between surfaces (progressive refinement radiosity)",
+        description="Add light bounced between surfaces (radiosity)",
         default=True,
+    )
+    indirect_solver: EnumProperty(
+        name="Solver",
+        description="How bounced light is computed",
+        items=(
+            ("PROGRESSIVE", "Progressive", "Progressive refinement over patches: the most accurate on small scenes"),
+            ("HIERARCHICAL", "Hierarchical", "Hierarchical radiosity with clusters: for large scenes, where progressive refinement is slow"),
+        ),
+        default="PROGRESSIVE",
     )
     convergence: FloatProperty(
         name="Convergence",

@@ -29,9 +29,10 @@ class PENUMBRA_PT_radiosity(bpy.types.Panel):
         sizes.prop(s, "penumbra_element_size")
 
         layout.prop(s, "use_indirect")
-        row = layout.row()
-        row.enabled = s.use_indirect
-        row.prop(s, "convergence")
+        col = layout.column()
+        col.enabled = s.use_indirect
+        col.prop(s, "indirect_solver")
+        col.prop(s, "convergence")
         layout.prop(s, "lighting_only")
         layout.prop(s, "hide_originals")
         layout.prop(s, "max_memory_gb")

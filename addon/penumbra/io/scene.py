@@ -76,6 +76,7 @@ def settings_dict(settings, meshes, lights):
         "tolerance": float(QUALITY_TOLERANCE[settings.quality]),
         "indirect": bool(settings.use_indirect),
         "convergence": float(settings.convergence),
+        "indirect_solver": str(settings.indirect_solver).lower(),
         "lighting_only": bool(settings.lighting_only),
     }
     # 0 leaves the core's default (half of the machine's memory).

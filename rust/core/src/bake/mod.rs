@@ -58,6 +58,11 @@ pub struct Stats {
     pub unshot_fraction: f64,
     /// Element vertices at which indirect light was computed (the rest interpolate).
     pub N_gather: u64,
+    /// Hierarchical solver: links, the visibility rays cast to make them, and memory of the
+    /// hierarchy and links per leaf (element triangle) in bytes.
+    pub N_links: u64,
+    pub rays: u64,
+    pub bytes_per_leaf: f64,
     /// Vertex×light pairs: skipped in umbra, computed unoccluded in lit regions, computed
     /// with visibility in penumbra.
     pub pairs_umbra: u64,
@@ -286,6 +291,9 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
         stats.shots = ind.shots;
         stats.unshot_fraction = ind.unshot_fraction;
         stats.N_gather = ind.gather_vertices;
+        stats.N_links = ind.links;
+        stats.rays = ind.rays;
+        stats.bytes_per_leaf = ind.bytes_per_leaf;
         for (e, i) in irradiance.iter_mut().zip(&ind.irradiance) {
             *e += *i;
         }
@@ -492,6 +500,14 @@ pub fn stats_table(s: &Stats) -> String {
         ),
         ("radiosity              T_rs (s)", format!("{:.4}", s.T_rs)),
         ("indirect at vertices   N_gather", s.N_gather.to_string()),
+        (
+            "links / rays           N_links",
+            format!("{} / {}", s.N_links, s.rays),
+        ),
+        (
+            "bytes per leaf (hierarchy+links)",
+            format!("{:.0}", s.bytes_per_leaf),
+        ),
         ("total                  (s)", format!("{:.4}", s.T_total)),
         (
             "shots / unshot fraction",

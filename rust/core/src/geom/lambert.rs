@@ -62,6 +62,31 @@ pub fn contours_irradiance(p: DVec3, n: DVec3, contours: &[Vec<DVec3>]) -> f64 {
     0.5 * s.abs()
 }
 
+/// Irradiance per unit radiance at `p` (normal `n`) from a planar region given by its
+/// boundary as directed edges, in any order (the contour sum is additive over edges, so the
+/// loops need not be traced): `Some` when the region lies wholly in front of `p`'s plane or
+/// wholly behind it (0), `None` when it straddles the plane and must be clipped as closed
+/// contours (`contours_irradiance`).
+pub fn edges_irradiance(p: DVec3, n: DVec3, edges: &[[DVec3; 2]]) -> Option<f64> {
+    // A vertex a rounding error behind the plane (a wall's foot seen from the floor) is on
+    // it: the edges it ends contribute nothing there, so the sum needs no clipping.
+    let (mut front, mut back) = (false, false);
+    for [a, _] in edges {
+        let r = *a - p;
+        let h = r.dot(n);
+        front |= h > 0.0;
+        back |= h < -1e-9 * r.length();
+    }
+    if back {
+        return if front { None } else { Some(0.0) };
+    }
+    let s: f64 = edges
+        .iter()
+        .map(|[a, b]| edge_term(n, *a - p, *b - *a, *b - p))
+        .sum();
+    Some(0.5 * s.abs())
+}
+
 /// Signed `Σ θ_i (n · Γ_i)` over the part of a closed contour in front of `p`.
 fn horizon_clipped_sum(p: DVec3, n: DVec3, contour: &[DVec3]) -> f64 {
     let k = contour.len();

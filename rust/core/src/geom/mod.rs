@@ -8,6 +8,7 @@ pub mod frame;
 pub mod lambert;
 pub mod plane;
 pub mod polygon;
+pub mod polygon_factor;
 pub mod raycast;
 pub mod simplify;
 pub mod union_find;

@@ -220,7 +220,22 @@ impl Occluders {
         skip: &[u32],
         out: &mut Vec<u32>,
     ) {
-        let Some(bvh) = &self.bvh else { return };
+        self.candidates_upto(lo, hi, planes, skip, usize::MAX, out);
+    }
+
+    /// As [`candidates`](Self::candidates), stopping once `out` holds more than `cap` faces
+    /// (then returns false): for callers that would rather cast rays through the BVH than
+    /// sift a long list.
+    pub fn candidates_upto(
+        &self,
+        lo: DVec3,
+        hi: DVec3,
+        planes: &[Plane],
+        skip: &[u32],
+        cap: usize,
+        out: &mut Vec<u32>,
+    ) -> bool {
+        let Some(bvh) = &self.bvh else { return true };
         let query = Aabb::new(
             to_f32(lo - self.centre - self.pad),
             to_f32(hi - self.centre + self.pad),
@@ -243,8 +258,9 @@ impl Occluders {
                     out.push(id);
                 }
             }
-            true
+            out.len() <= cap
         });
+        out.len() <= cap
     }
 
     /// The `f32` ray for the part of `o + t·dir`, `t ∈ [0, len]`, inside the scene's bounds:

@@ -29,6 +29,7 @@ mod blockers;
 pub(crate) mod coplanar_contacts;
 mod fit;
 mod gather;
+pub mod hierarchical;
 mod mls;
 mod pair;
 pub(crate) mod patches;
@@ -49,6 +50,7 @@ use crate::geom::raycast::Occluders;
 use crate::indirect::patches::{build_patches, Patch};
 use crate::mesh::elements::Elements;
 use crate::progress::Progress;
+use crate::scene::settings::IndirectSolver;
 use crate::scene::Scene;
 use crate::BakeError;
 
@@ -62,8 +64,16 @@ pub struct IndirectResult {
     pub gather_vertices: u64,
     pub shots: u64,
     /// Unshot power left at the end over the power emitted (reflected direct light plus
-    /// emission), before any ambient term.
+    /// emission), before any ambient term. For the hierarchical solver, the power the last
+    /// sweep added, over the power emitted.
     pub unshot_fraction: f64,
+    /// Hierarchical solver only: links after refinement, leaves (element triangles not
+    /// under a cover), visibility rays cast while refining, and memory of the hierarchy and
+    /// links per leaf in bytes.
+    pub links: u64,
+    pub leaves: u64,
+    pub rays: u64,
+    pub bytes_per_leaf: f64,
 }
 
 /// Patches whose apparent size (radius over distance) falls under these use 1 or ~4 rays
@@ -98,8 +108,24 @@ pub fn indirect(
     occ: &Occluders,
     progress: &Progress,
 ) -> Result<IndirectResult, BakeError> {
+    if scene.settings.indirect_solver == IndirectSolver::Hierarchical {
+        return hierarchical::indirect(scene, el, direct, occ, progress);
+    }
     let spacing = GATHER_SPACING * scene.settings.element_size;
     indirect_at(scene, el, direct, occ, progress, spacing)
+}
+
+/// One direct irradiance per element vertex, or an error naming the stage.
+fn check_direct(el: &Elements, direct: &[DVec3]) -> Result<(), BakeError> {
+    let nv = el.positions.len();
+    if direct.len() != nv {
+        return Err(BakeError::invalid(
+            "indirect",
+            "direct",
+            format!("{} values for {nv} element vertices", direct.len()),
+        ));
+    }
+    Ok(())
 }
 
 /// `indirect`, computed at vertices about `spacing` apart (every vertex for 0).
@@ -113,13 +139,7 @@ fn indirect_at(
 ) -> Result<IndirectResult, BakeError> {
     let settings = &scene.settings;
     let nv = el.positions.len();
-    if direct.len() != nv {
-        return Err(BakeError::invalid(
-            "indirect",
-            "direct",
-            format!("{} values for {nv} element vertices", direct.len()),
-        ));
-    }
+    check_direct(el, direct)?;
     let cover_tol = 1e-6 * scene.diagonal();
     let covers = crate::indirect::coplanar_contacts::covers(&scene.faces, cover_tol);
     let open = crate::indirect::coplanar_contacts::open_parts_of(&scene.faces, &covers, cover_tol);

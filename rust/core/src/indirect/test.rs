@@ -8,12 +8,12 @@ use crate::scene::settings::Settings;
 use crate::scene::test::face;
 use crate::scene::Face;
 
-fn v(x: f64, y: f64, z: f64) -> DVec3 {
+pub(crate) fn v(x: f64, y: f64, z: f64) -> DVec3 {
     DVec3::new(x, y, z)
 }
 
 /// A parallelogram centred at `c` facing `u × v`.
-fn quad(c: DVec3, u: DVec3, w: DVec3, albedo: f64, le: DVec3) -> Face {
+pub(crate) fn quad(c: DVec3, u: DVec3, w: DVec3, albedo: f64, le: DVec3) -> Face {
     face(
         &[c - u - w, c + u - w, c + u + w, c - u + w],
         DVec3::splat(albedo),
@@ -21,7 +21,7 @@ fn quad(c: DVec3, u: DVec3, w: DVec3, albedo: f64, le: DVec3) -> Face {
     )
 }
 
-fn scene(faces: Vec<Face>, settings: impl FnOnce(&mut Settings)) -> Scene {
+pub(crate) fn scene(faces: Vec<Face>, settings: impl FnOnce(&mut Settings)) -> Scene {
     let mut s = Settings::from_json(&SettingsJson::default(), 1.0).unwrap();
     settings(&mut s);
     let pts = faces.iter().flat_map(|f| f.verts.iter().copied());
@@ -51,7 +51,7 @@ fn run(scene: &Scene, k: usize) -> (Elements, IndirectResult) {
 
 /// Form factor from a point to a parallel rectangle a × b at height c, the point under
 /// one of its corners (Howell's catalogue, C-11).
-fn corner(a: f64, b: f64, c: f64) -> f64 {
+pub(crate) fn corner(a: f64, b: f64, c: f64) -> f64 {
     let (x, y) = (a / c, b / c);
     let (sx, sy) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());
     (x / sx * (y / sx).atan() + y / sy * (x / sy).atan()) / (2.0 * PI)
@@ -96,7 +96,7 @@ fn form_factor_matches_closed_forms() {
 
 /// A black 2×2 emitter of radiance `le` at height `h` facing down, over a 2×2 receiver of
 /// albedo `rho` at z = 0 facing up.
-fn plates(h: f64, le: DVec3, rho: f64) -> [Face; 2] {
+pub(crate) fn plates(h: f64, le: DVec3, rho: f64) -> [Face; 2] {
     [
         quad(v(0., 0., h), DVec3::Y, DVec3::X, 0.0, le),
         quad(DVec3::ZERO, DVec3::X, DVec3::Y, rho, DVec3::ZERO),
@@ -105,7 +105,7 @@ fn plates(h: f64, le: DVec3, rho: f64) -> [Face; 2] {
 
 /// Form factor from a point `x` on the plane z = 0 to the 2×2 square centred above the
 /// origin at height `h`, facing down: four corner rectangles.
-fn plate_factor(x: DVec3, h: f64) -> f64 {
+pub(crate) fn plate_factor(x: DVec3, h: f64) -> f64 {
     let (a, b) = (x.x + 1.0, x.y + 1.0);
     corner(a, b, h) + corner(2.0 - a, b, h) + corner(a, 2.0 - b, h) + corner(2.0 - a, 2.0 - b, h)
 }
@@ -323,7 +323,12 @@ fn blocker_between_plates_casts_full_shadow() {
 
 /// The inside of the unit cube: six quads facing in, all of albedo `rho` and emission
 /// `le`, plus `extra` faces.
-fn furnace(rho: f64, le: DVec3, extra: Vec<Face>, settings: impl FnOnce(&mut Settings)) -> Scene {
+pub(crate) fn furnace(
+    rho: f64,
+    le: DVec3,
+    extra: Vec<Face>,
+    settings: impl FnOnce(&mut Settings),
+) -> Scene {
     let c = v(0.5, 0.5, 0.5);
     let (x, y, z) = (DVec3::X * 0.5, DVec3::Y * 0.5, DVec3::Z * 0.5);
     let mut faces = vec![

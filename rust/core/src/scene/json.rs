@@ -125,6 +125,10 @@ pub struct SettingsJson {
     pub lighting_only: Option<bool>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub penumbra_visibility: Option<String>,
+    /// "progressive" (default: progressive refinement over patches) or "hierarchical"
+    /// (hierarchical radiosity with clustering, for large scenes).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub indirect_solver: Option<String>,
     /// "discontinuity" (default) or "uniform": a uniform mesh of `element_size`, with exact
     /// light at its vertices, for comparisons.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -12,6 +12,15 @@ pub enum PenumbraVisibility {
     Sampled,
 }
 
+/// How indirect light is solved (`indirect`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum IndirectSolver {
+    /// Progressive refinement over grid patches, gathered at element vertices.
+    Progressive,
+    /// Hierarchical radiosity with clustering on the discontinuity mesh.
+    Hierarchical,
+}
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct Settings {
     /// Element edge length outside penumbra.
@@ -33,6 +42,7 @@ pub struct Settings {
     pub ambient: bool,
     pub lighting_only: bool,
     pub penumbra_visibility: PenumbraVisibility,
+    pub indirect_solver: IndirectSolver,
     /// Mesh uniformly instead of along discontinuities (for comparisons).
     pub uniform: bool,
     pub penumbra_samples: u32,
@@ -133,6 +143,16 @@ impl Settings {
                 ))
             }
         };
+        let indirect_solver = match s.indirect_solver.as_deref() {
+            None | Some("progressive") => IndirectSolver::Progressive,
+            Some("hierarchical") => IndirectSolver::Hierarchical,
+            Some(o) => {
+                return Err(BakeError::setting(
+                    "indirect_solver",
+                    format!("{o:?} is not \"progressive\" or \"hierarchical\""),
+                ))
+            }
+        };
         let penumbra_samples = s.penumbra_samples.unwrap_or(64);
         if !(1..=65536).contains(&penumbra_samples) {
             return Err(BakeError::setting(
@@ -182,6 +202,7 @@ impl Settings {
             ambient: s.ambient.unwrap_or(false),
             lighting_only: s.lighting_only.unwrap_or(false),
             penumbra_visibility,
+            indirect_solver,
             uniform,
             penumbra_samples,
             visibility_rays,

@@ -1,0 +1,282 @@
+//! Stage 7: indirect light by hierarchical radiosity with clustering (Hanrahan, Salzman &
+//! Aupperle 1991; Smits, Arvo & Greenberg 1994; Sillion 1995), on the discontinuity mesh.
+//!
+//! Units follow `DESIGN.md`: irradiance E and radiosity B in W/m² per RGB channel; a face's
+//! `emission` is radiance, so it leaves the face as radiosity π·Le.
+//!
+//! The element triangles are the leaves of one tree (`hierarchy`): clusters of faces, a
+//! face, its regions (cut along the discontinuity loops first, so a lit region, a penumbra
+//! and an umbra never shoot as one), then halves of a region. Links between nodes (`link`)
+//! are made by refining the root's link to itself (`refine`) until each link's power is
+//! under a tolerance, near pairs down to leaves; visibility per link is a shaft test, then
+//! a fixed set of rays for the partly blocked (`visibility`). Jacobi sweeps with push–pull
+//! (`solve`) run until a sweep adds less than `convergence` of the emitted power, and each
+//! element vertex gathers once more over the links above it, with factors from the vertex
+//! itself (`vertices`). Every step gives the same bits
+//! for any thread count.
+//!
+//! Parts of faces lying against another face (`covered`) neither shoot nor receive.
+//!
+//! Settings: `convergence` sets both the link tolerance and the end of the solve;
+//! `visibility_rays` is the ray count for links carrying the most; `max_shots` caps the
+//! sweeps; `patch_size` is not used (the hierarchy replaces the grid patches).
+
+mod hierarchy;
+mod link;
+mod refine;
+mod solve;
+mod vertices;
+mod visibility;
+
+use std::f64::consts::PI;
+
+use glam::{DVec2, DVec3};
+
+use hierarchy::Hierarchy;
+use refine::Refiner;
+use solve::{Gathering, Leaves, Solver};
+use visibility::Visibility;
+
+use crate::geom::polygon::strictly_inside_convex;
+use crate::geom::raycast::Occluders;
+use crate::mesh::elements::Elements;
+use crate::progress::Progress;
+use crate::scene::Scene;
+use crate::BakeError;
+
+use super::IndirectResult;
+
+/// Refinement tolerance: a link may carry up to this times `convergence` of the emitted power.
+const EPS_SCALE: f64 = 1.0;
+/// The solve ends when a sweep adds less than this times `convergence` of the emitted power.
+const SWEEP_SCALE: f64 = 0.01;
+/// Leaves of the hierarchy are groups of element triangles whose centroids lie within this
+/// times `patch_size` of each other's centre.
+const LEAF_RADIUS: f64 = 0.25;
+
+/// Links allowed per leaf (plus `LINK_FLOOR`) before the bake is refused: bounds memory.
+const LINKS_PER_LEAF: u64 = 400;
+const LINK_FLOOR: u64 = 1 << 22;
+/// Cap on sweeps whatever `max_shots` says.
+const MAX_SWEEPS: u64 = 1000;
+
+/// Hierarchical radiosity over the element mesh `el` of `scene`, starting from the direct
+/// irradiance `direct` (one per element vertex). Checks `progress` for cancellation while
+/// refining and between sweeps.
+pub fn indirect(
+    scene: &Scene,
+    el: &Elements,
+    direct: &[DVec3],
+    occ: &Occluders,
+    progress: &Progress,
+) -> Result<IndirectResult, BakeError> {
+    let settings = &scene.settings;
+    let nv = el.positions.len();
+    super::check_direct(el, direct)?;
+    let faces = &scene.faces;
+    let covers = crate::indirect::coplanar_contacts::covers(faces, 1e-6 * scene.diagonal());
+    let leaf_radius = LEAF_RADIUS * settings.patch_size;
+    let mut h = Hierarchy::build(faces, el, |t| !covered(scene, el, &covers, t), leaf_radius);
+    h.set_boxes(faces, el);
+    let nl = h.order.len();
+    let mut result = IndirectResult {
+        patches: h.nodes.len() as u64,
+        leaves: nl as u64,
+        gather_vertices: nv as u64,
+        irradiance: vec![DVec3::ZERO; nv],
+        ..Default::default()
+    };
+    progress.check()?;
+
+    let leaves = leaf_inputs(scene, el, direct, &h);
+    let emitted_power: f64 = (0..nl)
+        .map(|i| {
+            let b = leaves.albedo[i] * leaves.direct[i] + leaves.emitted[i];
+            b.element_sum() * h.area[i]
+        })
+        .sum();
+    if !(emitted_power > 0.0) || !emitted_power.is_finite() {
+        result.bytes_per_leaf = h.bytes_per_leaf();
+        return Ok(result);
+    }
+
+    let b_max = radiosity_bounds(&h, &leaves, emitted_power);
+    let b_range = first_radiosity_range(&h, &leaves);
+    let max_links = LINKS_PER_LEAF * nl as u64 + LINK_FLOOR;
+    let refiner = Refiner::new(
+        Visibility {
+            h: &h,
+            faces,
+            el,
+            occ,
+        },
+        &b_max,
+        &b_range,
+        EPS_SCALE * settings.convergence * emitted_power,
+        settings.visibility_rays,
+        max_links,
+        progress,
+    );
+    let refined = refiner.run();
+    progress.check()?;
+    if refined.over_budget {
+        return Err(BakeError::setting(
+            "convergence",
+            format!(
+                "{} is too fine for this scene: over {max_links} links for {nl} elements \
+                 (raise it, or raise element_size)",
+                settings.convergence
+            ),
+        ));
+    }
+    result.links = refined.links.len() as u64;
+    result.rays = refined.rays;
+    let g = Gathering::new(refined.links, h.nodes.len());
+    result.bytes_per_leaf = h.bytes_per_leaf()
+        + (g.links.len() * std::mem::size_of::<link::Link>() + g.start.len() * 4) as f64
+            / nl.max(1) as f64;
+
+    progress.set_fraction(0.0);
+    let solver = Solver::new(&h, faces, &g);
+    let max_sweeps = settings.max_shots.clamp(1, MAX_SWEEPS);
+    let sol = solver.solve(
+        &leaves,
+        emitted_power,
+        settings.convergence * SWEEP_SCALE,
+        max_sweeps,
+        progress,
+    )?;
+    result.shots = sol.sweeps;
+    result.unshot_fraction = sol.last_change;
+    progress.check()?;
+    let b = sol.radiosity.as_ref().expect("the solve pulls at its end");
+    let mut at = vertices::gathered(&h, faces, el, &g, &solver, b);
+    if settings.ambient {
+        let amb = ambient(&h, &leaves, sol.last_delta);
+        at.iter_mut().for_each(|e| *e += amb);
+    }
+    result.irradiance = at;
+    Ok(result)
+}
+
+/// Whether element triangle `t` lies under a cover of its face (its centroid inside one).
+fn covered(scene: &Scene, el: &Elements, covers: &[Vec<Vec<DVec2>>], t: u32) -> bool {
+    let f = el.tri_face[t as usize] as usize;
+    if covers[f].is_empty() {
+        return false;
+    }
+    let c = el.triangles[t as usize]
+        .iter()
+        .map(|&v| el.positions[v as usize])
+        .sum::<DVec3>()
+        / 3.0;
+    let p = scene.faces[f].frame.to_2d(c);
+    covers[f].iter().any(|poly| strictly_inside_convex(poly, p))
+}
+
+/// Per leaf position: direct irradiance (the mean of its corners'), albedo, π·Le.
+fn leaf_inputs(scene: &Scene, el: &Elements, direct: &[DVec3], h: &Hierarchy) -> Leaves {
+    let face = |t: u32| &scene.faces[el.tri_face[t as usize] as usize];
+    let light_faces: std::collections::BTreeSet<u32> =
+        scene.lights.iter().filter_map(|l| l.from_face).collect();
+    Leaves {
+        direct: h
+            .order
+            .iter()
+            .map(|&t| {
+                el.triangles[t as usize]
+                    .iter()
+                    .map(|&v| direct[v as usize])
+                    .sum::<DVec3>()
+                    / 3.0
+            })
+            .collect(),
+        albedo: h.order.iter().map(|&t| face(t).albedo).collect(),
+        // Emissive faces that are also area lights have sent their light as direct light.
+        emitted: h
+            .order
+            .iter()
+            .map(|&t| {
+                let f = el.tri_face[t as usize];
+                if light_faces.contains(&f) {
+                    DVec3::ZERO
+                } else {
+                    PI * face(t).emission
+                }
+            })
+            .collect(),
+    }
+}
+
+/// Per node, a bound on its radiosity over the solve (channels summed), for refinement:
+/// its leaves' largest first radiosity, plus its albedo times the irradiance that the
+/// emitted power would give everywhere after endless bounces (light reaches shadowed
+/// surfaces only by bounces, and they must refine too).
+fn radiosity_bounds(h: &Hierarchy, leaves: &Leaves, emitted_power: f64) -> Vec<f64> {
+    let area = h.nodes[0].area.max(1e-300);
+    let rho_mean = (0..h.order.len())
+        .map(|i| leaves.albedo[i] * h.area[i])
+        .sum::<DVec3>()
+        / area;
+    let bounce = emitted_power / area / (1.0 - rho_mean.max_element().min(0.95));
+    let mut b = vec![0.0; h.nodes.len()];
+    for i in (0..h.nodes.len()).rev() {
+        let n = &h.nodes[i];
+        b[i] = if n.is_leaf() {
+            (n.lo as usize..n.hi as usize)
+                .map(|p| {
+                    let first = leaves.albedo[p] * leaves.direct[p] + leaves.emitted[p];
+                    first.element_sum() + leaves.albedo[p].max_element() * bounce
+                })
+                .fold(0.0, f64::max)
+        } else {
+            b[n.kids[0] as usize].max(b[n.kids[1] as usize])
+        };
+    }
+    b
+}
+
+/// Per node, how much its leaves' first radiosity (reflected direct light plus emission,
+/// channels summed) varies over it: a source whose light is not uniform sends it unevenly,
+/// and a mean over it misplaces that light (the bright pool under a lamp).
+fn first_radiosity_range(h: &Hierarchy, leaves: &Leaves) -> Vec<f64> {
+    let mut lo = vec![f64::INFINITY; h.nodes.len()];
+    let mut hi = vec![f64::NEG_INFINITY; h.nodes.len()];
+    for i in (0..h.nodes.len()).rev() {
+        let n = &h.nodes[i];
+        if n.is_leaf() {
+            for p in n.lo as usize..n.hi as usize {
+                let b = (leaves.albedo[p] * leaves.direct[p] + leaves.emitted[p]).element_sum();
+                lo[i] = lo[i].min(b);
+                hi[i] = hi[i].max(b);
+            }
+        } else {
+            for k in n.kids {
+                lo[i] = lo[i].min(lo[k as usize]);
+                hi[i] = hi[i].max(hi[k as usize]);
+            }
+        }
+    }
+    lo.iter().zip(&hi).map(|(l, h)| (h - l).max(0.0)).collect()
+}
+
+/// Cohen et al.'s ambient term for what the sweeps left: the last sweep added `delta`
+/// (area-weighted mean irradiance); each later one would add about ρ times the one before.
+/// The final gather at the vertices is one of those (it gathers the radiosity the last
+/// sweep's irradiance gives), so what is left starts at ρ²: ρ²/(1 − ρ) times `delta`.
+/// Assumes a closed scene.
+fn ambient(h: &Hierarchy, leaves: &Leaves, delta: DVec3) -> DVec3 {
+    let area = h.nodes[0].area;
+    if !(area > 0.0) {
+        return DVec3::ZERO;
+    }
+    let rho = (0..h.order.len())
+        .map(|i| leaves.albedo[i] * h.area[i])
+        .sum::<DVec3>()
+        / area;
+    let rho = rho.min(DVec3::splat(0.999));
+    delta.max(DVec3::ZERO) * rho * rho / (DVec3::ONE - rho)
+}
+
+#[cfg(test)]
+pub(crate) mod test;

@@ -1,0 +1,308 @@
+//! Link refinement (Hanrahan, Salzman & Aupperle 1991, with clusters as Smits, Arvo &
+//! Greenberg 1994): starting from the root linked to itself, a link is split, by splitting the
+//! larger of its two nodes, while
+//! - the two are in each other's near field (closer than their sizes add up), or
+//! - the error it could make, `B_s · F · A_r · (size / distance)²` (the source's largest
+//!   radiosity, a form factor that errs high, the receiver's area, and the relative error
+//!   of a point-to-disc factor), is over `eps`, or
+//! - a face lies in the shaft between them and the power is over `eps / PARTIAL`, or
+//! - rays find it partly hidden and the power is over `eps / SHADOW` (then the receiver
+//!   is split first: a shadow varies over it).
+//!
+//! Otherwise the link is kept with its visibility. Pairs on one face, pairs wholly behind
+//! either plane and fully blocked pairs carry nothing and are dropped. Leaf pairs are kept
+//! whatever they carry. The recursion forks with `rayon::join` and concatenates in a fixed
+//! order, so the links are the same for any thread count.
+
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+
+use super::hierarchy::Node;
+use super::link::{Ends, Link};
+use super::visibility::Visibility;
+use crate::progress::Progress;
+
+/// Near field: nodes whose centroids are closer than this times the sum of their radii.
+const NEAR: f64 = 1.0;
+/// Links whose shaft holds a listed blocker are split while their power exceeds
+/// `eps / PARTIAL`.
+const PARTIAL: f64 = 16.0;
+/// Links found partly hidden by rays are split while their power exceeds `eps / SHADOW`.
+const SHADOW: f64 = 256.0;
+/// Points of a receiver at which the factor's spread over it is sampled.
+const VARY_POINTS: u32 = 6;
+/// Receivers over which a source's factor varies by more than this fraction of its value
+/// at the centroid are split, for links carrying over `eps / VARY_POWER`.
+const VARY_REL: f64 = 0.1;
+const VARY_POWER: f64 = 64.0;
+/// Sources whose first radiosity varies by more than `VARY_REL` are split for links
+/// carrying over `eps / SOURCE_VARY_POWER` of that variation.
+const SOURCE_VARY_POWER: f64 = 1024.0;
+/// Pairs with fewer leaves than this (receiver × source) are refined on one thread.
+const SERIAL_BELOW: u64 = 1 << 12;
+
+pub struct Refiner<'a> {
+    pub vis: Visibility<'a>,
+    /// Upper bound of each node's radiosity over the solve (summed over channels).
+    pub b_max: &'a [f64],
+    /// How much each node's first radiosity varies over it.
+    pub b_range: &'a [f64],
+    pub eps: f64,
+    /// Rays for links carrying more than `eps` (leaf pairs in the near field).
+    pub rays: u32,
+    pub max_links: u64,
+    pub progress: &'a Progress,
+    links: AtomicU64,
+    rays_cast: AtomicU64,
+    /// Area pairs settled (linked or dropped), as `f64` bits: progress over the total.
+    settled: AtomicU64,
+    total: f64,
+    stop: AtomicBool,
+}
+
+pub struct Refined {
+    pub links: Vec<Link>,
+    pub rays: u64,
+    /// The link budget ran out (`max_links`).
+    pub over_budget: bool,
+}
+
+impl<'a> Refiner<'a> {
+    pub fn new(
+        vis: Visibility<'a>,
+        b_max: &'a [f64],
+        b_range: &'a [f64],
+        eps: f64,
+        rays: u32,
+        max_links: u64,
+        progress: &'a Progress,
+    ) -> Self {
+        let total = vis.h.nodes.first().map_or(0.0, |n| n.area * n.area);
+        Refiner {
+            vis,
+            b_max,
+            b_range,
+            eps,
+            rays,
+            max_links,
+            progress,
+            links: AtomicU64::new(0),
+            rays_cast: AtomicU64::new(0),
+            settled: AtomicU64::new(0f64.to_bits()),
+            total,
+            stop: AtomicBool::new(false),
+        }
+    }
+
+    /// All links, from the root's link to itself.
+    pub fn run(&self) -> Refined {
+        let mut links = Vec::new();
+        if !self.vis.h.nodes.is_empty() {
+            self.refine(0, 0, &mut links);
+        }
+        Refined {
+            links,
+            rays: self.rays_cast.load(Ordering::Relaxed),
+            over_budget: self.links.load(Ordering::Relaxed) > self.max_links,
+        }
+    }
+
+    fn node(&self, i: u32) -> &Node {
+        &self.vis.h.nodes[i as usize]
+    }
+
+    fn settle(&self, r: &Node, s: &Node) {
+        let add = r.area * s.area;
+        let mut cur = self.settled.load(Ordering::Relaxed);
+        loop {
+            let next = (f64::from_bits(cur) + add).to_bits();
+            match self.settled.compare_exchange_weak(
+                cur,
+                next,
+                Ordering::Relaxed,
+                Ordering::Relaxed,
+            ) {
+                Ok(_) => break,
+                Err(c) => cur = c,
+            }
+        }
+    }
+
+    fn refine(&self, r: u32, s: u32, out: &mut Vec<Link>) {
+        if self.stop.load(Ordering::Relaxed) {
+            return;
+        }
+        let (rn, sn) = (self.node(r), self.node(s));
+        if r == s {
+            if rn.is_leaf() || rn.is_planar() {
+                self.settle(rn, sn);
+                return;
+            }
+            let [a, b] = rn.kids;
+            return self.split(&[(a, a), (a, b), (b, a), (b, b)], out);
+        }
+        if rn.is_planar() && rn.face == sn.face {
+            self.settle(rn, sn);
+            return;
+        }
+        let h = self.vis.h;
+        let ends = Ends::new(h, self.vis.faces, r, s);
+        // Wholly behind either plane: nothing passes.
+        let behind = |n: &Node, plane_node: &Node, normal: Option<glam::DVec3>| {
+            normal.is_some_and(|nrm| {
+                let c = plane_node.centroid;
+                let lo = n.lo_box - c;
+                let hi = n.hi_box - c;
+                // Largest of nrm·(x − c) over the box.
+                let top = nrm.x.max(0.0) * hi.x
+                    + nrm.x.min(0.0) * lo.x
+                    + nrm.y.max(0.0) * hi.y
+                    + nrm.y.min(0.0) * lo.y
+                    + nrm.z.max(0.0) * hi.z
+                    + nrm.z.min(0.0) * lo.z;
+                top <= 0.0
+            })
+        };
+        if behind(sn, rn, ends.nr) || behind(rn, sn, ends.ns) {
+            self.settle(rn, sn);
+            return;
+        }
+        let both_leaves = rn.is_leaf() && sn.is_leaf();
+        let dist = ends.offset().length();
+        let near = dist < NEAR * (rn.radius() + sn.radius());
+        let power = self.b_max[s as usize] * ends.factor_bound() * rn.area;
+        // The point and disc estimates are off by about (size / distance)²: the error the
+        // link would make, not the light it carries, decides.
+        let spread = ((rn.radius() + sn.radius()) / dist.max(1e-300)).min(1.0);
+        let error = power * spread * spread;
+        if !both_leaves && (near || error > self.eps) && !self.over_budget() {
+            return self.split_larger(r, s, out);
+        }
+        // The link gives every point of the receiver its mean factor: where the factor
+        // varies over the receiver (a wall whose part by a corner sees less of the far
+        // walls), the light it would misplace decides, not only what the mean misses.
+        if !rn.is_leaf() && !self.over_budget() {
+            if let (Some(nr), Some(ns)) = (ends.nr, ends.ns) {
+                let f0 = super::link::far_factor(rn.centroid, nr, sn, ns);
+                let vary = (0..VARY_POINTS)
+                    .map(|i| {
+                        let (x, _) = self.vis.sample(rn, i, VARY_POINTS, 0);
+                        (super::link::far_factor(x, nr, sn, ns) - f0).abs()
+                    })
+                    .fold(0.0, f64::max);
+                // Every source's factor falls off the same way towards a corner, so these
+                // errors add up coherently over the links: bound each one's relative spread.
+                let carried = self.b_max[s as usize] * f0 * rn.area;
+                if vary > VARY_REL * f0 && carried > self.eps / VARY_POWER {
+                    let [a, b] = rn.kids;
+                    return self.split(&[(a, s), (b, s)], out);
+                }
+            }
+        }
+        // The source sends its mean radiosity times the mean share of its light that reaches
+        // the receiver: where the radiosity varies over the source, the share does too, and
+        // the product of means loses light coherently over the links (0.34 % of each bounce
+        // in a lit empty room at eps / VARY_POWER, the empty room 1.1 % low). Split the
+        // source down to a finer bound.
+        if !sn.is_leaf() && !self.over_budget() {
+            let carried = self.b_range[s as usize] * ends.factor_bound() * rn.area;
+            if self.b_range[s as usize] > VARY_REL * self.b_max[s as usize]
+                && carried > self.eps / SOURCE_VARY_POWER
+            {
+                let [a, b] = sn.kids;
+                return self.split(&[(r, a), (r, b)], out);
+            }
+        }
+        let blockers = self.vis.blockers(rn, sn);
+        // A shaft with something in it is treated as partly blocked without a ray: a few
+        // rays can miss a small blocker near one end (a leg under a seat).
+        let listed = blockers.as_ref().is_some_and(|l| !l.is_empty());
+        if listed && !both_leaves && power > self.eps / PARTIAL && !self.over_budget() {
+            return self.split_larger(r, s, out);
+        }
+        // Something may be in the way of a link carrying much: sample it more densely.
+        let rays = if error > self.eps / 4.0 { self.rays } else { 4 };
+        let (v, cast) = self.vis.fraction_among(rn, sn, blockers.as_deref(), rays);
+        if cast > 0 {
+            self.rays_cast.fetch_add(cast as u64, Ordering::Relaxed);
+        }
+        // Partly hidden: the shadow varies over the receiver, and a mean over it would
+        // light its dark part (the seat right above a leg). Split the receiver first.
+        if v < 1.0
+            && (v > 0.0 || cast > 0)
+            && !both_leaves
+            && power > self.eps / SHADOW
+            && !self.over_budget()
+        {
+            return if rn.is_leaf() {
+                self.split_larger(r, s, out)
+            } else {
+                let [a, b] = rn.kids;
+                self.split(&[(a, s), (b, s)], out)
+            };
+        }
+        self.settle(rn, sn);
+        if v > 0.0 {
+            let link = ends.link(h, self.vis.el, r, s, v);
+            if link.k > 0.0 || ends.factor_bound() > 0.0 {
+                out.push(link);
+                let n = self.links.fetch_add(1, Ordering::Relaxed) + 1;
+                if n % 4096 == 0 {
+                    let done = f64::from_bits(self.settled.load(Ordering::Relaxed));
+                    self.progress.set_fraction(done / self.total.max(1e-300));
+                    if self.progress.is_cancelled() {
+                        self.stop.store(true, Ordering::Relaxed);
+                    }
+                }
+            }
+        }
+    }
+
+    fn over_budget(&self) -> bool {
+        let over = self.links.load(Ordering::Relaxed) > self.max_links;
+        if over {
+            self.stop.store(true, Ordering::Relaxed);
+        }
+        over
+    }
+
+    fn split_larger(&self, r: u32, s: u32, out: &mut Vec<Link>) {
+        let (rn, sn) = (self.node(r), self.node(s));
+        let split_r = !rn.is_leaf() && (sn.is_leaf() || rn.area >= sn.area);
+        if split_r {
+            let [a, b] = rn.kids;
+            self.split(&[(a, s), (b, s)], out)
+        } else {
+            let [a, b] = sn.kids;
+            self.split(&[(r, a), (r, b)], out)
+        }
+    }
+
+    /// Refines `pairs` into `out` in their order, in parallel when they are large.
+    fn split(&self, pairs: &[(u32, u32)], out: &mut Vec<Link>) {
+        let size = |&(r, s): &(u32, u32)| {
+            let (a, b) = (self.node(r), self.node(s));
+            (a.hi - a.lo) as u64 * (b.hi - b.lo) as u64
+        };
+        if pairs.len() < 2 || pairs.iter().map(size).sum::<u64>() < SERIAL_BELOW {
+            for &(r, s) in pairs {
+                self.refine(r, s, out);
+            }
+            return;
+        }
+        let (a, b) = pairs.split_at(pairs.len() / 2);
+        let (mut la, lb) = rayon::join(
+            || {
+                let mut v = Vec::new();
+                self.split(a, &mut v);
+                v
+            },
+            || {
+                let mut v = Vec::new();
+                self.split(b, &mut v);
+                v
+            },
+        );
+        out.append(&mut la);
+        out.extend(lb);
+    }
+}

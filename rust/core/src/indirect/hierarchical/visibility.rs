@@ -1,0 +1,230 @@
+//! Visibility between two nodes, deterministic: first a shaft test against the BVH (the faces
+//! whose box meets the box around both nodes, in front of both nodes' planes, and whose plane
+//! has points of the two on opposite sides: for convex objects and rooms, usually none), so
+//! most links need no ray; the others are the fraction of a fixed stratified set of segments
+//! between points of the two nodes that no face crosses.
+
+use glam::DVec3;
+
+use super::hierarchy::{Hierarchy, Node};
+use crate::geom::raycast::Occluders;
+use crate::geom::Plane;
+use crate::mesh::elements::Elements;
+use crate::scene::Face;
+
+/// Blocker lists longer than this go to the BVH per segment instead.
+const MAX_LISTED: usize = 32;
+/// Shaft tests give up (and rays go through the BVH) past this many candidate faces: for
+/// large nodes in clutter, sifting every face in the box costs more than a few rays.
+const MAX_CANDIDATES: usize = 64;
+
+pub struct Visibility<'a> {
+    pub h: &'a Hierarchy,
+    pub faces: &'a [Face],
+    pub el: &'a Elements,
+    pub occ: &'a Occluders,
+}
+
+impl Visibility<'_> {
+    /// What could block some segment between `r` and `s`: nothing, a short list of faces,
+    /// or too many to list (`None`: ask the BVH per segment).
+    pub fn blockers(&self, r: &Node, s: &Node) -> Option<Vec<u32>> {
+        let mut planes: Vec<Plane> = Vec::with_capacity(2);
+        let mut skip: Vec<u32> = Vec::with_capacity(2);
+        for n in [r, s] {
+            if n.is_planar() {
+                planes.push(self.faces[n.face as usize].plane);
+                skip.push(n.face);
+            }
+        }
+        let (lo, hi) = (r.lo_box.min(s.lo_box), r.hi_box.max(s.hi_box));
+        let mut out = Vec::new();
+        if !self
+            .occ
+            .candidates_upto(lo, hi, &planes, &skip, MAX_CANDIDATES, &mut out)
+        {
+            return None;
+        }
+        if out.is_empty() {
+            return Some(out);
+        }
+        let corners = corners(r);
+        out.retain(|&id| self.occ.straddled_by(id, &corners, s.lo_box, s.hi_box));
+        Some(out)
+    }
+
+    /// Fraction of `rays` segments between points of `r` and `s` that nothing blocks; 1
+    /// without a ray when nothing can be in the way. Also returns the rays cast.
+    #[cfg(test)]
+    pub fn fraction(&self, r: &Node, s: &Node, rays: u32) -> (f64, u32) {
+        self.fraction_among(r, s, self.blockers(r, s).as_deref(), rays)
+    }
+
+    /// `fraction`, given the `blockers` between `r` and `s` (`None`: unknown, use the BVH).
+    pub fn fraction_among(
+        &self,
+        r: &Node,
+        s: &Node,
+        list: Option<&[u32]>,
+        rays: u32,
+    ) -> (f64, u32) {
+        if list.is_some_and(|l| l.is_empty()) {
+            return (1.0, 0);
+        }
+        let skip: Vec<u32> = [r, s]
+            .iter()
+            .filter(|n| n.is_planar())
+            .map(|n| n.face)
+            .collect();
+        let k = rays.max(1);
+        // Only segments whose ends face each other carry light: on a cluster (a box), points
+        // on faces turned away would be hidden by the box itself, and counting them would
+        // dim a link whose light all comes from the faces turned towards the receiver.
+        // Candidates are drawn from a longer fixed sequence until `k` such segments are found.
+        let blocked = |a: DVec3, b: DVec3| match list {
+            Some(l) if l.len() <= MAX_LISTED => self.occ.segment_blocked_by(a, b, l),
+            _ => self.occ.segment_blocked_skip(a, b, &skip),
+        };
+        // Each segment counts by its own point-to-point factor cosθ·cosθs / d²: the part
+        // of a large source next to the receiver carries most of the light, and it is the
+        // part least often hidden (a floor beside a box among clutter).
+        let soft = s.area / (std::f64::consts::PI * k as f64);
+        let (mut open, mut total, mut counted) = (0.0f64, 0.0f64, 0u32);
+        for i in 0..4 * k {
+            if counted >= k {
+                break;
+            }
+            let (a, na) = self.sample(r, i % k, k, i / k);
+            let (b, nb) = self.sample(s, (i * 5 + 1) % k, k, i / k);
+            let d = b - a;
+            let (ca, cb) = (na.dot(d), -nb.dot(d));
+            if ca > 0.0 && cb > 0.0 {
+                counted += 1;
+                let d2 = d.length_squared();
+                let w = ca * cb / (d2 * (d2 + soft));
+                total += w;
+                if !blocked(a, b) {
+                    open += w;
+                }
+            }
+        }
+        if counted > 0 && total > 0.0 {
+            return (open / total, counted);
+        }
+        // No pair faces each other (a sliver seen edge-on): every segment counts.
+        let open = (0..k)
+            .filter(|&i| {
+                let (a, _) = self.sample(r, i, k, 0);
+                let (b, _) = self.sample(s, (i * 5 + 1) % k, k, 0);
+                !blocked(a, b)
+            })
+            .count();
+        (open as f64 / k as f64, k)
+    }
+
+    /// The `i`-th of `k` points on node `n` (in round `round`, which shifts the points within
+    /// their leaf), with its face's normal: leaves spread over its range, and several points
+    /// inside a leaf when there are fewer leaves than points.
+    pub fn sample(&self, n: &Node, i: u32, k: u32, round: u32) -> (DVec3, DVec3) {
+        let count = n.hi - n.lo;
+        let (leaf, j, m) = if count >= k {
+            (
+                n.lo + ((2 * i as u64 + 1) * count as u64 / (2 * k as u64)) as u32,
+                0,
+                1,
+            )
+        } else {
+            (n.lo + i % count, i / count, k.div_ceil(count))
+        };
+        let t = self.h.order[leaf as usize] as usize;
+        let [a, b, c] = self.el.triangles[t].map(|v| self.el.positions[v as usize]);
+        let (mut u, mut v) = if m == 1 && round == 0 {
+            (1.0 / 3.0, 1.0 / 3.0)
+        } else {
+            let m = m * (round + 1);
+            let j = j * (round + 1) + round;
+            let x = (j as f64 + 0.5) / m as f64;
+            (x, (x * 0.618_033_988_749_895 * m as f64).fract())
+        };
+        if u + v > 1.0 {
+            (u, v) = (1.0 - u, 1.0 - v);
+        }
+        let normal = self.faces[self.el.tri_face[t] as usize].plane.n;
+        (a * (1.0 - u - v) + b * u + c * v, normal)
+    }
+}
+
+fn corners(n: &Node) -> [DVec3; 8] {
+    let (lo, hi) = (n.lo_box, n.hi_box);
+    std::array::from_fn(|i| {
+        DVec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        )
+    })
+}
+
+#[cfg(test)]
+mod test {
+    use super::*;
+    use crate::indirect::patches::test::grid_elements;
+    use crate::scene::test::face;
+
+    fn square(z: f64, s: f64, up: bool) -> Face {
+        let v = |x, y| DVec3::new(x, y, z);
+        let mut p = vec![v(-s, -s), v(s, -s), v(s, s), v(-s, s)];
+        if !up {
+            p.reverse();
+        }
+        face(&p, DVec3::ONE, DVec3::ZERO)
+    }
+
+    #[test]
+    fn open_half_and_fully_blocked_pairs() {
+        // Floor facing up, ceiling facing down; a blocker in between covering half (x < 0).
+        let floor = square(0.0, 1.0, true);
+        let ceil = square(1.0, 1.0, false);
+        let v = |x, y| DVec3::new(x, y, 0.5);
+        let half = face(
+            &[v(-3.0, -3.0), v(0.0, -3.0), v(0.0, 3.0), v(-3.0, 3.0)],
+            DVec3::ONE,
+            DVec3::ZERO,
+        );
+        let faces = vec![floor.clone(), ceil.clone(), half];
+        let el = grid_elements(&faces[..2], 4);
+        let occ = Occluders::new(&faces);
+        let mut h = Hierarchy::build(&faces, &el, |_| true, 0.0);
+        h.set_boxes(&faces, &el);
+        let vis = Visibility {
+            h: &h,
+            faces: &faces,
+            el: &el,
+            occ: &occ,
+        };
+        let [a, b] = h.nodes[0].kids.map(|k| &h.nodes[k as usize]);
+        let (f, c) = if a.face == 0 { (a, b) } else { (b, a) };
+        assert_eq!(vis.blockers(f, c), Some(vec![2]));
+        let (v, rays) = vis.fraction(f, c, 16);
+        assert_eq!(rays, 16);
+        assert!(v > 0.1 && v < 0.9, "{v}");
+        // A leaf wholly under the blocker sees nothing of a leaf over it.
+        let leaf_at = |face: u32, x: f64| {
+            h.nodes
+                .iter()
+                .find(|n| n.is_leaf() && n.face == face && n.hi_box.x < x)
+                .unwrap()
+        };
+        assert_eq!(vis.fraction(leaf_at(0, -0.2), leaf_at(1, -0.2), 4).0, 0.0);
+        // Without the blocker: no candidates, no rays.
+        let faces2 = vec![floor, ceil];
+        let occ2 = Occluders::new(&faces2);
+        let vis2 = Visibility {
+            h: &h,
+            faces: &faces2,
+            el: &el,
+            occ: &occ2,
+        };
+        assert_eq!(vis2.fraction(f, c, 16), (1.0, 0));
+    }
+}
