@@ -451,7 +451,7 @@ fn output(scene: &Scene, tol: &Tolerances, el: &Elements, colors: &[[f64; 3]]) -
 /// The stats as a text table in the layout of the paper's Tables 2 and 4.
 pub fn stats_table(s: &Stats) -> String {
     let mut t = String::new();
-    let rows: [(&str, String); 25] = [
+    let rows: [(&str, String); 27] = [
         ("receivers before loop split  N_f1", s.N_f1.to_string()),
         ("faces after loop split       N_f2", s.N_f2.to_string()),
         ("discontinuity edges          N_d", s.N_d.to_string()),

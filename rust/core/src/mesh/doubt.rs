@@ -11,6 +11,9 @@
 //! what is split is still decided by the exact light.
 
 use std::collections::HashMap;
+use std::hash::BuildHasherDefault;
+
+use super::refine::KeyHasher;
 
 use glam::{DVec2, DVec3};
 
@@ -49,7 +52,8 @@ pub(crate) fn doubtful(
         .iter()
         .map(|t| t.iter().map(|&v| positions[v as usize]).sum::<DVec2>() / 3.0)
         .collect();
-    let mut by_edge: HashMap<(u32, u32), u32> = HashMap::with_capacity(triangles.len() * 2);
+    let mut by_edge: HashMap<(u32, u32), u32, BuildHasherDefault<KeyHasher>> =
+        HashMap::with_capacity_and_hasher(triangles.len() * 2, Default::default());
     let mut neighbour = vec![[u32::MAX; 3]; triangles.len()];
     for (t, tri) in triangles.iter().enumerate() {
         for k in 0..3 {

@@ -451,6 +451,9 @@ fn extract(
     let mut comp = vec![u32::MAX; faces.len()];
     // The largest triangle of each component, whose centre is classified.
     let mut largest: Vec<usize> = Vec::new();
+    // Components that reach the hull across an edge that is not a constraint lie outside the
+    // receiver, between its boundary and the frame refinement puts around it (`refine`).
+    let mut outside: Vec<bool> = Vec::new();
     for start in 0..faces.len() {
         if comp[start] != u32::MAX {
             continue;
@@ -459,6 +462,7 @@ fn extract(
         let mut stack = vec![start];
         comp[start] = id;
         let mut best = (0.0f64, start);
+        let mut out = false;
         while let Some(i) = stack.pop() {
             let area = faces[i].area();
             if area > best.0 {
@@ -467,6 +471,9 @@ fn extract(
             for e in faces[i].adjacent_edges() {
                 if e.is_constraint_edge() {
                     continue;
+                }
+                if e.rev().face().is_outer() {
+                    out = true;
                 }
                 if let Some(nb) = e.rev().face().as_inner() {
                     let j = face_index(nb.fix());
@@ -478,6 +485,7 @@ fn extract(
             }
         }
         largest.push(best.1);
+        outside.push(out);
     }
     // A dense receiver has hundreds of thousands of components, each classified on its own.
     let centres: Vec<DVec2> = largest
@@ -487,7 +495,20 @@ fn extract(
             DVec2::new(c.x, c.y) - shift
         })
         .collect();
-    let regions: Vec<Region> = centres.par_iter().map(|&c| rr.classify(c)).collect();
+    let regions: Vec<Region> = centres
+        .par_iter()
+        .zip(&outside)
+        .map(|(&c, &out)| {
+            if out {
+                Region {
+                    relations: Vec::new(),
+                    blockers: Vec::new(),
+                }
+            } else {
+                rr.classify(c)
+            }
+        })
+        .collect();
 
     // D0 split: group the triangles around each vertex into sectors that do not cross a
     // lit|umbra edge; every sector but the first gets its own copy of the vertex.
@@ -525,7 +546,7 @@ fn extract(
             return false;
         };
         let (ca, cb) = (comp[face_index(fa.fix())], comp[face_index(fb.fix())]);
-        if ca == cb {
+        if ca == cb || outside[ca as usize] || outside[cb as usize] {
             return false;
         }
         if lit_umbra(&regions[ca as usize], &regions[cb as usize]) {
@@ -565,7 +586,7 @@ fn extract(
             .filter(|&k| cut(k))
             .map(|k| {
                 let q = out[k].to().position();
-                DVec2::new(q.x, q.y) - positions[vh.index()]
+                DVec2::new(q.x, q.y) - shift - positions[vh.index()]
             })
             .collect();
         let straight = cuts.len() == 2
@@ -579,7 +600,11 @@ fn extract(
             if s > 0 && cut(k) && !current.is_empty() {
                 sectors.push(std::mem::take(&mut current));
             }
-            match out[k].face().as_inner() {
+            match out[k]
+                .face()
+                .as_inner()
+                .filter(|f| !outside[comp[face_index(f.fix())] as usize])
+            {
                 Some(f) => current.push(face_index(f.fix())),
                 // The receiver's boundary ends a sector too: on a boundary vertex the two
                 // sides of a D0 line meet again only across the outside.
@@ -636,6 +661,15 @@ fn extract(
     }
     let _ = nv;
     let mut tri_region = comp;
+    if outside.iter().any(|&o| o) {
+        drop_outside(
+            &outside,
+            &mut positions,
+            &mut eval,
+            &mut triangles,
+            &mut tri_region,
+        );
+    }
     drop_flat(&positions, frame, &mut triangles, &mut tri_region, tol);
     ReceiverMesh {
         positions,
@@ -645,6 +679,44 @@ fn extract(
         regions,
         d0_corners,
         ..ReceiverMesh::default()
+    }
+}
+
+/// Removes the triangles of components outside the receiver, and the vertices only they
+/// used (the frame's corners).
+fn drop_outside(
+    outside: &[bool],
+    positions: &mut Vec<DVec2>,
+    eval: &mut Vec<DVec2>,
+    triangles: &mut Vec<[u32; 3]>,
+    tri_region: &mut Vec<u32>,
+) {
+    let keep: Vec<bool> = tri_region.iter().map(|&r| !outside[r as usize]).collect();
+    let mut k = keep.iter();
+    triangles.retain(|_| *k.next().unwrap_or(&true));
+    let mut k = keep.iter();
+    tri_region.retain(|_| *k.next().unwrap_or(&true));
+    let mut new_id = vec![u32::MAX; positions.len()];
+    for t in triangles.iter() {
+        for &v in t {
+            new_id[v as usize] = 0;
+        }
+    }
+    let mut n = 0u32;
+    for (v, id) in new_id.iter_mut().enumerate() {
+        if *id == 0 {
+            *id = n;
+            positions[n as usize] = positions[v];
+            eval[n as usize] = eval[v];
+            n += 1;
+        }
+    }
+    positions.truncate(n as usize);
+    eval.truncate(n as usize);
+    for t in triangles.iter_mut() {
+        for v in t.iter_mut() {
+            *v = new_id[*v as usize];
+        }
     }
 }
 

@@ -42,12 +42,11 @@ pub const FLOOR: f64 = 0.01;
 pub const SAFETY: f64 = 0.4;
 /// Passes at most: each halves the elements that fail, so 30 passes span 2^30 in size.
 pub const MAX_PASSES: u32 = 30;
-/// Refinement stops after a pass that added fewer vertices than the elements over this
-/// (and than `TAIL_MIN`).
-pub const TAIL_FRACTION: u64 = 1000;
-pub const TAIL_MIN: u64 = 8;
-/// A triangle lower than this fraction of an edge is flat: its edges are not split.
-pub const FLAT: f64 = 1e-3;
+/// A triangle lower than this fraction of an edge is flat: its edges are not split. Only
+/// rounding makes such triangles (three points of one kinked constraint line); a thin
+/// triangle that geometry made (a strip along a receiver's edge, where light comes round
+/// the corner) is split like any other (it was 1e-3, which left 2e-5-high strips whole).
+pub const FLAT: f64 = 1e-6;
 /// The lower size bound as a fraction of `penumbra_element_size`.
 pub const LOWER_BOUND: f64 = 1.0 / 16.0;
 
@@ -74,6 +73,33 @@ fn key(p: DVec2) -> [u64; 2] {
     [p.x.to_bits(), p.y.to_bits()]
 }
 
+/// A hasher for the light cache's keys (bits of two coordinates): the standard SipHash was a
+/// sixth of a direct-only bake of data1 (`perf`), for keys no adversary chooses.
+#[derive(Default, Clone, Copy)]
+pub(crate) struct KeyHasher(u64);
+
+impl std::hash::Hasher for KeyHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for chunk in bytes.chunks(8) {
+            let mut word = [0u8; 8];
+            word[..chunk.len()].copy_from_slice(chunk);
+            self.write_u64(u64::from_le_bytes(word));
+        }
+    }
+    fn write_u64(&mut self, x: u64) {
+        // One multiply-rotate step per word (as rustc's FxHasher).
+        self.0 = (self.0.rotate_left(5) ^ x).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+    fn write_usize(&mut self, x: usize) {
+        self.write_u64(x as u64);
+    }
+}
+
+type Cache = HashMap<[u64; 2], (DVec3, [u64; 3]), std::hash::BuildHasherDefault<KeyHasher>>;
+
 /// Refines `cdt` until every element meets `settings.tolerance` or the lower bound, and
 /// returns the element mesh (D0 rows and corners split) with the direct light known at
 /// every vertex.
@@ -91,7 +117,8 @@ pub(crate) fn refine(
 ) -> Result<(ReceiverMesh, RefineStats), BakeError> {
     let lower = lower_bound(settings);
     let mut stats = RefineStats::default();
-    let mut cache: HashMap<[u64; 2], (DVec3, [u64; 3])> = HashMap::new();
+    let mut cache = Cache::default();
+    add_frame(cdt);
     loop {
         progress.check()?;
         let mut m = extract(cdt, shift, rr, frame, false, tol);
@@ -103,23 +130,31 @@ pub(crate) fn refine(
 
         // Vertex values: each with the regions of the triangles around it (after the D0 and
         // corner splits, only those of its own side).
-        let mut around: Vec<Vec<u32>> = vec![Vec::new(); nv];
-        for (t, tri) in m.triangles.iter().enumerate() {
-            for &v in tri {
-                let r = m.tri_region[t];
-                if !around[v as usize].contains(&r) {
-                    around[v as usize].push(r);
-                }
-            }
-        }
         let missing: Vec<usize> = (0..nv)
             .filter(|&v| !cache.contains_key(&key(m.eval[v])))
             .collect();
+        let mut slot = vec![u32::MAX; nv];
+        for (k, &v) in missing.iter().enumerate() {
+            slot[v] = k as u32;
+        }
+        let mut around: Vec<Vec<u32>> = vec![Vec::new(); missing.len()];
+        for (t, tri) in m.triangles.iter().enumerate() {
+            for &v in tri {
+                let k = slot[v as usize];
+                if k == u32::MAX {
+                    continue;
+                }
+                let r = m.tri_region[t];
+                if !around[k as usize].contains(&r) {
+                    around[k as usize].push(r);
+                }
+            }
+        }
         let values: Vec<_> = missing
             .par_iter()
-            .map(|&v| {
-                let regs: Vec<&Region> =
-                    around[v].iter().map(|&r| &m.regions[r as usize]).collect();
+            .zip(&around)
+            .map(|(&v, around)| {
+                let regs: Vec<&Region> = around.iter().map(|&r| &m.regions[r as usize]).collect();
                 light(m.eval[v], &regs)
             })
             .collect();
@@ -128,8 +163,9 @@ pub(crate) fn refine(
             cache.insert(key(m.eval[v]), val);
         }
         progress.check()?;
-        let value = |v: u32| cache[&key(m.eval[v as usize])].0;
-        let floor = (0..nv as u32).map(value).fold(DVec3::ZERO, DVec3::max) * FLOOR;
+        let vals: Vec<DVec3> = m.eval.iter().map(|p| cache[&key(*p)].0).collect();
+        let value = |v: u32| vals[v as usize];
+        let floor = vals.iter().fold(DVec3::ZERO, |a, b| a.max(*b)) * FLOOR;
 
         let used = budget.load(Ordering::Relaxed);
         if stats.passes >= MAX_PASSES as u64 || used >= settings.max_elements {
@@ -183,6 +219,22 @@ pub(crate) fn refine(
                     interp: (value(tri[0]) + value(tri[1]) + value(tri[2])) / 3.0,
                     split: Split::Centroid((p[0] + p[1] + p[2]) / 3.0),
                 });
+                // In penumbra the light kinks along critical lines that no constraint
+                // follows, and a kink inside an element errs most beside it, not at the
+                // midpoints: three more points, halfway from the centroid to each corner.
+                if region.relations.contains(&Relation::Penumbra) {
+                    let centre = (p[0] + p[1] + p[2]) / 3.0;
+                    let centre_eval = (c[0] + c[1] + c[2]) / 3.0;
+                    let centre_value = (value(tri[0]) + value(tri[1]) + value(tri[2])) / 3.0;
+                    for k in 0..3 {
+                        samples.push(Sample {
+                            tri: t as u32,
+                            at: 0.5 * (centre_eval + c[k]),
+                            interp: 0.5 * (centre_value + value(tri[k])),
+                            split: Split::Centroid(0.5 * (centre + p[k])),
+                        });
+                    }
+                }
             }
         }
         let mut todo: Vec<(DVec2, u32)> = samples
@@ -221,7 +273,9 @@ pub(crate) fn refine(
         }
         for s in &samples {
             if let Split::Centroid(c) = s.split {
+                // One interior point per element and pass.
                 if !edge_failed[s.tri as usize] && fails(s) {
+                    edge_failed[s.tri as usize] = true;
                     centroids.push(c);
                 }
             }
@@ -232,7 +286,11 @@ pub(crate) fn refine(
 
         // Back to the CDT's vertices: copies made by the D0 and corner splits stand for the
         // CDT vertex at their position.
-        let handle_at: HashMap<[u64; 2], FixedVertexHandle> = cdt
+        let handle_at: HashMap<
+            [u64; 2],
+            FixedVertexHandle,
+            std::hash::BuildHasherDefault<KeyHasher>,
+        > = cdt
             .fixed_vertices()
             .map(|h| {
                 let p = cdt.vertex(h).position();
@@ -262,7 +320,7 @@ pub(crate) fn refine(
             }
             split_edge(cdt, a, b);
         }
-        for c in centroids {
+        for &c in &centroids {
             if cdt.num_vertices() - before >= room {
                 break;
             }
@@ -273,11 +331,9 @@ pub(crate) fn refine(
         budget.fetch_add(added, Ordering::Relaxed);
         stats.passes += 1;
         stats.vertices_added += added;
-        // A pass costs a whole extraction of the receiver; once passes only add a handful
-        // of vertices (the last elements at a D0 corner or a kink halving down to the lower
-        // bound), the tail is not worth its passes: this pass's points are the last.
-        let tail = (m.triangles.len() as u64 / TAIL_FRACTION).max(TAIL_MIN);
-        if added < tail {
+        // Every split was refused (kinked constraints, rounding): the next pass would find
+        // the same elements.
+        if added == 0 {
             return Ok(finish(
                 extract_split(cdt, shift, rr, frame, tol),
                 &cache,
@@ -302,7 +358,7 @@ fn extract_split(
 /// The mesh with the values known at its vertices.
 fn finish(
     mut m: ReceiverMesh,
-    cache: &HashMap<[u64; 2], (DVec3, [u64; 3])>,
+    cache: &Cache,
     mut stats: RefineStats,
 ) -> (ReceiverMesh, RefineStats) {
     stats.elements_after = m.triangles.len() as u64;
@@ -340,9 +396,10 @@ fn insert_inside(cdt: &mut Cdt, p: Point2<f64>) {
     }
 }
 
-/// Splits the CDT edge `a`→`b` (the failed triangle on its left) near its midpoint. An
-/// edge inside a region takes the midpoint as a new vertex. A constraint (a D1/D0 edge) or
-/// a boundary edge is split by the triangulation itself (`split_constraint`).
+/// Splits the CDT edge `a`→`b` (the failed triangle on its left) at its midpoint. An edge
+/// inside a region takes the midpoint as a new vertex. A constraint (a D1/D0 edge, or the
+/// receiver's boundary, which the frame put inside the triangulation) is split by the
+/// triangulation itself (`split_constraint`).
 fn split_edge(cdt: &mut Cdt, a: FixedVertexHandle, b: FixedVertexHandle) {
     let (pa, pb) = (cdt.vertex(a).position(), cdt.vertex(b).position());
     let mid = Point2::new(0.5 * (pa.x + pb.x), 0.5 * (pa.y + pb.y));
@@ -352,7 +409,10 @@ fn split_edge(cdt: &mut Cdt, a: FixedVertexHandle, b: FixedVertexHandle) {
         return;
     };
     let edge = cdt.directed_edge(e);
-    if !edge.is_constraint_edge() && !edge.as_undirected().is_part_of_convex_hull() {
+    if edge.as_undirected().is_part_of_convex_hull() {
+        return;
+    }
+    if !edge.is_constraint_edge() {
         // An edge of a flat triangle (three points of one kinked constraint line, spanned
         // by the triangulation): its midpoint lies on that line to within rounding, and
         // would cut slivers that rounding may turn over (tests/mesh_validity.rs).
@@ -375,50 +435,140 @@ fn split_edge(cdt: &mut Cdt, a: FixedVertexHandle, b: FixedVertexHandle) {
         insert_inside(cdt, mid);
         return;
     }
-    split_constraint(cdt, e);
+    split_constraint(cdt, e, mid);
 }
 
-/// Splits a constraint or boundary edge in the triangulation's own structure. Inserted as a
-/// point, its rounded midpoint lies a hair off the line, and the constraint put back through
-/// it leaves a sliver between the line and the point, or a triangle that rounding turns
-/// over (tests/mesh_validity.rs). spade splits an existing constraint in place only where
-/// a new constraint crosses it: so a constraint is drawn from the vertex opposite the edge
-/// on one side to the one on the other, which splits the edge where it crosses; the drawn
-/// constraint is then unmarked, and the edge's halves stay one constraint line.
-fn split_constraint(cdt: &mut Cdt, e: spade::handles::FixedDirectedEdgeHandle) {
+/// Splits a constraint edge at `mid` (its midpoint) in the triangulation's own structure.
+/// Inserted as a point, a rounded midpoint lies a hair off the line, and the constraint put
+/// back through it leaves a sliver between the line and the point, or a triangle that
+/// rounding turns over (tests/mesh_validity.rs). spade splits an existing constraint in
+/// place only where a new constraint crosses it, at a point its caller chooses: so a
+/// constraint is drawn from the vertex opposite the edge on one side to the one on the
+/// other, split at `mid`, and then unmarked, and the edge's halves stay one constraint line.
+/// Where that line would leave the two triangles (their quadrilateral is not convex), it is
+/// drawn to a vertex put for the purpose just beyond the midpoint, and removed after.
+fn split_constraint(cdt: &mut Cdt, e: spade::handles::FixedDirectedEdgeHandle, mid: Point2<f64>) {
     let edge = cdt.directed_edge(e);
-    let (a, b) = (edge.from().position(), edge.to().position());
-    let Some(c) = edge.opposite_vertex().map(|v| v.fix()) else {
+    let (ha, hb) = (edge.from().fix(), edge.to().fix());
+    let p2 = |p: Point2<f64>| DVec2::new(p.x, p.y);
+    let (a, b) = (p2(edge.from().position()), p2(edge.to().position()));
+    let (Some(c), Some(d)) = (
+        edge.opposite_vertex().map(|v| v.fix()),
+        edge.rev().opposite_vertex().map(|v| v.fix()),
+    ) else {
         return;
     };
-    let pc = cdt.vertex(c).position();
-    let p2 = |p: Point2<f64>| DVec2::new(p.x, p.y);
-    let (da, db) = (p2(a), p2(b));
+    let (pc, pd) = (p2(cdt.vertex(c).position()), p2(cdt.vertex(d).position()));
     let crosses = |from: DVec2, to: DVec2| {
-        let (sa, sb) = (orient(from, to, da), orient(from, to, db));
+        let (sa, sb) = (orient(from, to, a), orient(from, to, b));
         (sa > 0.0 && sb < 0.0) || (sa < 0.0 && sb > 0.0)
     };
-    // A boundary edge has no vertex beyond it to draw to: it is left whole (its elements
-    // are refined from inside only).
-    let Some(d) = edge.rev().opposite_vertex().map(|v| v.fix()) else {
-        return;
-    };
-    let pd = p2(cdt.vertex(d).position());
-    // Where the drawn constraint crosses, as a fraction of the edge: near an end it would
-    // leave a needle of a triangle.
-    let (u, w) = (db - da, pd - p2(pc));
-    let den = u.perp_dot(w);
-    let at = if den != 0.0 {
-        (p2(pc) - da).perp_dot(w) / den
-    } else {
-        -1.0
-    };
-    if !(0.2..=0.8).contains(&at) {
+    if crosses(pc, pd) {
+        draw_and_unmark(cdt, (ha, hb), c, d, mid);
         return;
     }
-    if crosses(p2(pc), pd) {
-        for drawn in cdt.add_constraint_and_split(c, d, |p| p) {
+    // A vertex strictly inside the triangle a, d, b, on the line from c through the
+    // midpoint: the line from c to it crosses the edge and nothing else.
+    let m = p2(mid);
+    let side = orient(a, b, pd).signum();
+    let inside = |q: DVec2| {
+        orient(a, b, q) * side > 0.0
+            && orient(b, pd, q) * side > 0.0
+            && orient(pd, a, q) * side > 0.0
+    };
+    let mut t = 1.0;
+    let mut beyond = None;
+    for _ in 0..40 {
+        let q = m + (m - pc) * t;
+        if inside(q) && crosses(pc, q) {
+            beyond = Some(q);
+            break;
+        }
+        t *= 0.5;
+    }
+    let Some(q) = beyond else {
+        return;
+    };
+    let Ok(temp) = cdt.insert(Point2::new(q.x, q.y)) else {
+        return;
+    };
+    // Inserting legalises edges beyond the constraint only: c still faces the edge.
+    if cdt.get_edge_from_neighbors(ha, hb).is_some() {
+        draw_and_unmark(cdt, (ha, hb), c, temp, mid);
+    }
+    cdt.remove(temp);
+}
+
+/// Draws a constraint from `c` to `d` that splits what it crosses at `mid`, then unmarks
+/// what it drew. Where `mid` is no valid split point, spade connects to a vertex nearby
+/// instead, and the drawn line may then run along a constraint that was there before (a
+/// boundary edge): that one stays marked, or the receiver would lose its boundary.
+fn draw_and_unmark(
+    cdt: &mut Cdt,
+    (a, b): (FixedVertexHandle, FixedVertexHandle),
+    c: FixedVertexHandle,
+    d: FixedVertexHandle,
+    mid: Point2<f64>,
+) {
+    // spade takes `mid` where it lies on the edge or in a triangle beside it; elsewhere (a
+    // vertex there already, or rounding past a thin triangle) it would route the edge
+    // through a vertex nearby instead, moving the constraint: left unsplit then.
+    let Some(edge) = cdt.get_edge_from_neighbors(a, b) else {
+        return;
+    };
+    let (e, left, right) = (
+        edge.fix().as_undirected(),
+        edge.face().fix(),
+        edge.rev().face().fix(),
+    );
+    let valid = match cdt.locate(mid) {
+        PositionInTriangulation::OnEdge(x) => x.as_undirected() == e,
+        PositionInTriangulation::OnFace(f) => {
+            left.as_inner() == Some(f) || right.as_inner() == Some(f)
+        }
+        _ => false,
+    };
+    if !valid {
+        return;
+    }
+    let mut before: Vec<(FixedVertexHandle, FixedVertexHandle)> = Vec::new();
+    for v in [c, d] {
+        for e in cdt.vertex(v).out_edges() {
+            if e.is_constraint_edge() {
+                let (x, y) = (e.from().fix(), e.to().fix());
+                before.push((x.min(y), x.max(y)));
+            }
+        }
+    }
+    let drawn_edges = cdt.add_constraint_and_split(c, d, |_| mid);
+    for drawn in drawn_edges {
+        let e = cdt.directed_edge(drawn);
+        let (x, y) = (e.from().fix(), e.to().fix());
+        if !before.contains(&(x.min(y), x.max(y))) {
             cdt.remove_constraint_edge(drawn.as_undirected());
         }
+    }
+}
+
+/// Puts four vertices around the receiver, so that its boundary edges lie inside the
+/// triangulation with a triangle beyond them, and are split as the D1/D0 edges are
+/// (`split_constraint`). Extraction leaves out the triangles between the boundary and the
+/// frame (`extract`). Split from the hull instead, a boundary edge's midpoint becomes a hull
+/// vertex, and removing a helper vertex beyond a straight run of boundary vertices left
+/// flat triangles that stopped its splits.
+fn add_frame(cdt: &mut Cdt) {
+    let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+    for v in cdt.vertices() {
+        let p = DVec2::new(v.position().x, v.position().y);
+        lo = lo.min(p);
+        hi = hi.max(p);
+    }
+    if !(lo.x < hi.x && lo.y < hi.y) {
+        return;
+    }
+    let pad = (hi - lo).max_element();
+    let (lo, hi) = (lo - DVec2::splat(pad), hi + DVec2::splat(pad));
+    for p in [lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)] {
+        let _ = cdt.insert(Point2::new(p.x, p.y));
     }
 }
