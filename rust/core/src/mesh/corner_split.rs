@@ -5,9 +5,11 @@
 //! each carries the limit of the light from its own side, as the D0 rows do along a line.
 
 use std::collections::HashMap;
+use std::hash::BuildHasherDefault;
 
 use glam::DVec2;
 
+use super::refine::KeyHasher;
 use super::ReceiverMesh;
 use crate::scene::Tolerances;
 
@@ -26,7 +28,8 @@ pub(crate) fn split(m: &mut ReceiverMesh, d0_lines: &[[DVec2; 2]], tol: &Toleran
     let near = 1e-9 * scale;
     let cell = 1e-6 * scale;
     let at = |p: DVec2| ((p.x / cell).floor() as i64, (p.y / cell).floor() as i64);
-    let mut ends: HashMap<(i64, i64), Vec<DVec2>> = HashMap::new();
+    let mut ends: HashMap<(i64, i64), Vec<DVec2>, BuildHasherDefault<KeyHasher>> =
+        HashMap::default();
     let line_ends = d0_lines.iter().flat_map(|&[a, b]| [a, b]);
     for e in line_ends.chain(m.d0_corners.iter().copied()) {
         ends.entry(at(e)).or_default().push(e);

@@ -96,6 +96,12 @@ impl std::hash::Hasher for KeyHasher {
     fn write_usize(&mut self, x: usize) {
         self.write_u64(x as u64);
     }
+    fn write_i64(&mut self, x: i64) {
+        self.write_u64(x as u64);
+    }
+    fn write_u32(&mut self, x: u32) {
+        self.write_u64(x as u64);
+    }
 }
 
 type Cache = HashMap<[u64; 2], (DVec3, [u64; 3]), std::hash::BuildHasherDefault<KeyHasher>>;
