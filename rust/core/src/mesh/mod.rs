@@ -537,10 +537,12 @@ fn extract(
             && p.y <= a.y.max(b.y) + eps
             && seg_dist(a, b, p) <= eps
     };
+    let grid = LineGrid::new(&rr.d0_lines, eps);
     let on_contact = |p: DVec2, q: DVec2| {
-        rr.d0_lines
-            .iter()
-            .any(|&[a, b]| near(a, b, p) && near(a, b, q))
+        grid.at(p).iter().any(|&l| {
+            let [a, b] = rr.d0_lines[l as usize];
+            near(a, b, p) && near(a, b, q)
+        })
     };
     type Edge<'a> = spade::handles::DirectedEdgeHandle<'a, Point2<f64>, (), spade::CdtEdge<()>, ()>;
     let is_d0_uncached = |e: Edge<'_>| -> bool {
@@ -696,6 +698,67 @@ fn extract(
         regions,
         d0_corners,
         ..ReceiverMesh::default()
+    }
+}
+
+/// Segments by the cells of a grid their boxes (grown by `eps`) cover, for point queries.
+struct LineGrid {
+    lo: DVec2,
+    cell: f64,
+    n: usize,
+    cells: Vec<Vec<u32>>,
+}
+
+impl LineGrid {
+    /// Cells along each axis at most.
+    const SIDE: usize = 64;
+
+    fn new(lines: &[[DVec2; 2]], eps: f64) -> Self {
+        let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+        for [a, b] in lines {
+            lo = lo.min(a.min(*b));
+            hi = hi.max(a.max(*b));
+        }
+        let n = if lines.len() < 16 { 1 } else { Self::SIDE };
+        if !(lo.x <= hi.x && lo.y <= hi.y) {
+            return LineGrid {
+                lo: DVec2::ZERO,
+                cell: 1.0,
+                n: 1,
+                cells: vec![Vec::new()],
+            };
+        }
+        let lo = lo - DVec2::splat(2.0 * eps);
+        let cell = ((hi - lo).max_element() + 4.0 * eps) / n as f64;
+        let cell = if cell > 0.0 { cell } else { 1.0 };
+        let mut grid = LineGrid {
+            lo,
+            cell,
+            n,
+            cells: vec![Vec::new(); n * n],
+        };
+        for (l, [a, b]) in lines.iter().enumerate() {
+            let (i0, j0) = grid.index(a.min(*b) - DVec2::splat(eps));
+            let (i1, j1) = grid.index(a.max(*b) + DVec2::splat(eps));
+            for j in j0..=j1 {
+                for i in i0..=i1 {
+                    grid.cells[j * n + i].push(l as u32);
+                }
+            }
+        }
+        grid
+    }
+
+    fn index(&self, p: DVec2) -> (usize, usize) {
+        let f = (p - self.lo) / self.cell;
+        let clamp = |x: f64| (x.max(0.0) as usize).min(self.n - 1);
+        (clamp(f.x), clamp(f.y))
+    }
+
+    /// The segments whose grown boxes may hold `p` (and others).
+    fn at(&self, p: DVec2) -> &[u32] {
+        let (i, j) = self.index(p);
+        &self.cells[j * self.n + i]
     }
 }
 
