@@ -245,19 +245,41 @@ pub(crate) fn refine(
                 }
             }
         }
-        let mut todo: Vec<(DVec2, u32)> = samples
+        // A midpoint may become a vertex, whose value is then this one: on an edge between
+        // two regions it takes both (a lit region's shortcut is right only inside it).
+        let mut tri_of_edge: HashMap<(u32, u32), u32, std::hash::BuildHasherDefault<KeyHasher>> =
+            HashMap::with_capacity_and_hasher(3 * m.triangles.len(), Default::default());
+        for (t, tri) in m.triangles.iter().enumerate() {
+            for k in 0..3 {
+                tri_of_edge.insert((tri[k], tri[(k + 1) % 3]), t as u32);
+            }
+        }
+        let mut todo: Vec<(DVec2, u32, u32)> = samples
             .iter()
             .filter(|s| !cache.contains_key(&key(s.at)))
-            .map(|s| (s.at, s.tri))
+            .map(|s| {
+                let other = match s.split {
+                    Split::Edge(a, b) => tri_of_edge.get(&(b, a)).copied().unwrap_or(s.tri),
+                    Split::Centroid(_) => s.tri,
+                };
+                (s.at, s.tri, other)
+            })
             .collect();
-        todo.sort_unstable_by_key(|(p, _)| key(*p));
-        todo.dedup_by_key(|(p, _)| key(*p));
+        todo.sort_unstable_by_key(|(p, _, _)| key(*p));
+        todo.dedup_by_key(|(p, _, _)| key(*p));
         let values: Vec<_> = todo
             .par_iter()
-            .map(|&(q, t)| light(q, &[&m.regions[m.tri_region[t as usize] as usize]]))
+            .map(|&(q, t, o)| {
+                let (rt, ro) = (m.tri_region[t as usize], m.tri_region[o as usize]);
+                if rt == ro {
+                    light(q, &[&m.regions[rt as usize]])
+                } else {
+                    light(q, &[&m.regions[rt as usize], &m.regions[ro as usize]])
+                }
+            })
             .collect();
         stats.evaluations += values.len() as u64;
-        for (&(q, _), val) in todo.iter().zip(values) {
+        for (&(q, _, _), val) in todo.iter().zip(values) {
             cache.insert(key(q), val);
         }
         progress.check()?;
