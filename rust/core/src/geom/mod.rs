@@ -4,6 +4,7 @@
 
 pub mod box_grid;
 pub mod bvh;
+pub mod edge_soup;
 pub mod frame;
 pub mod lambert;
 pub mod plane;

@@ -216,8 +216,8 @@ fn edges_sum(a: &[[DVec3; 2]], b: &[[DVec3; 2]]) -> f64 {
 
 /// `A_r F(r ← s)` for two planar regions given as directed boundary edges (counter-clockwise
 /// around their fronts, any order), each wholly in front of the other's plane or on it: the
-/// caller checks that, since a region of several loops cannot be clipped edge by edge. For
-/// the groups of element triangles of hierarchical radiosity's leaves.
+/// caller clips them first where they are not (`edge_soup::clip_front`). For the groups of
+/// element triangles of hierarchical radiosity's leaves.
 pub fn edges_coupling(r: &[[DVec3; 2]], s: &[[DVec3; 2]]) -> f64 {
     let n = 2 * (r.len() + s.len());
     if r.len() < 3 || s.len() < 3 {

@@ -247,14 +247,7 @@ impl Occluders {
                 if !self.boxes[id as usize].intersect_aabb(&query) || skip.contains(&id) {
                     continue;
                 }
-                let f = &self.faces[id as usize];
-                if f.edges.is_empty() {
-                    continue;
-                }
-                if planes
-                    .iter()
-                    .all(|p| f.verts.iter().any(|v| p.dist(*v) > self.tol))
-                {
+                if self.in_front_of_all(id, planes) {
                     out.push(id);
                 }
             }
@@ -289,6 +282,15 @@ impl Occluders {
             0.0,
             (t1 - t0 + 2.0 * self.pad) as f32,
         ))
+    }
+
+    /// Whether face `id` has area and points in front of each of `planes`.
+    pub fn in_front_of_all(&self, id: u32, planes: &[Plane]) -> bool {
+        let f = &self.faces[id as usize];
+        !f.edges.is_empty()
+            && planes
+                .iter()
+                .all(|p| f.verts.iter().any(|v| p.dist(*v) > self.tol))
     }
 
     /// Whether face `id`'s bounds overlap the box `lo`–`hi` (both grown by the padding):

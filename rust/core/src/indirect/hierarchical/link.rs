@@ -16,6 +16,7 @@
 use glam::{DVec3, Vec3};
 
 use super::hierarchy::{Hierarchy, Node};
+use crate::geom::edge_soup::clip_front;
 use crate::geom::lambert::{edges_irradiance, polygon_irradiance};
 use crate::geom::polygon_factor::edges_coupling;
 use crate::mesh::elements::Elements;
@@ -82,7 +83,15 @@ impl<'a> Ends<'a> {
     }
 
     /// The link with visibility `v` (fraction of the source seen from the receiver).
-    pub fn link(&self, h: &Hierarchy, el: &Elements, receiver: u32, source: u32, v: f64) -> Link {
+    pub fn link(
+        &self,
+        h: &Hierarchy,
+        el: &Elements,
+        receiver: u32,
+        source: u32,
+        v: f64,
+        sample: bool,
+    ) -> Link {
         let pi = std::f64::consts::PI;
         let d = self.offset();
         let d2 = d.length_squared();
@@ -96,7 +105,7 @@ impl<'a> Ends<'a> {
                     .flatten()
                 {
                     k
-                } else if near {
+                } else if near && sample {
                     // The factor varies over a receiver close to its source (two leaves
                     // meeting at a corner): its mean over points spread on the receiver,
                     // each point's taken exactly, keeps the light the receiver gets.
@@ -107,6 +116,10 @@ impl<'a> Ends<'a> {
                         .map(|&(t, w)| w * triangle_mean(&f, t, MEAN_DEPTH))
                         .sum::<f64>()
                         / total.max(1e-300)
+                } else if near {
+                    // A link carrying too little to sample: the factor at the receiver's
+                    // centroid (the second-order term is a far-field one, and unbounded here).
+                    planar_factor(h, el, self.r.centroid, nr, self.s, ns, POINT_DEPTH)
                 } else {
                     planar_factor(h, el, self.r.centroid, nr, self.s, ns, POINT_DEPTH)
                         + receiver_term(self.r, nr, self.s, ns)
@@ -150,10 +163,11 @@ pub fn point_coefficient(
 }
 
 /// The exact mean factor from leaf `s` (normal `ns`) over leaf `r` (normal `nr`), by the
-/// double contour integral over their boundaries (`geom::polygon_factor`), when each lies
-/// wholly in front of the other's plane (or on it); `None` otherwise, or when either is not
-/// a leaf. Near leaves (a wall's strip by a corner, a leg's top under a seat) are where a
-/// quadrature over the receiver errs most, and always high or low for every source alike.
+/// double contour integral over their boundaries (`geom::polygon_factor`), each cut to the
+/// part in front of the other's plane; `None` when either is not a leaf. Near leaves (a
+/// wall's strip by a corner, a leg's top under a seat, a floor reaching past a box's side)
+/// are where a quadrature over the receiver errs most, and always high or low for every
+/// source alike.
 fn exact_pair(h: &Hierarchy, r: u32, s: u32, nr: DVec3, ns: DVec3) -> Option<f64> {
     let (rn, sn) = (&h.nodes[r as usize], &h.nodes[s as usize]);
     if !rn.is_leaf() || !sn.is_leaf() || !(rn.area > 0.0) {
@@ -163,10 +177,13 @@ fn exact_pair(h: &Hierarchy, r: u32, s: u32, nr: DVec3, ns: DVec3) -> Option<f64
     let tol = 1e-9 * (rn.radius() + sn.radius());
     let in_front =
         |e: &[[DVec3; 2]], c: DVec3, n: DVec3| e.iter().all(|[a, _]| (*a - c).dot(n) >= -tol);
-    if !in_front(re, sn.centroid, ns) || !in_front(se, rn.centroid, nr) {
-        return None;
+    if in_front(re, sn.centroid, ns) && in_front(se, rn.centroid, nr) {
+        return Some(edges_coupling(re, se) / rn.area);
     }
-    Some(edges_coupling(re, se) / rn.area)
+    let (mut rc, mut sc) = (Vec::new(), Vec::new());
+    clip_front(re, nr, sn.centroid, ns, tol, &mut rc);
+    clip_front(se, ns, rn.centroid, nr, tol, &mut sc);
+    Some(edges_coupling(&rc, &sc) / rn.area)
 }
 
 /// Form factor from the point `p` (normal `n`) to the triangles of the planar node `s`
@@ -198,6 +215,21 @@ mod test {
     use crate::indirect::patches::test::grid_elements;
     use crate::scene::test::face;
 
+    /// The hierarchy over two faces meshed 4×4, one leaf per triangle, and the nodes of
+    /// face 0 (the receiver) and face 1.
+    fn face_nodes(faces: &[Face]) -> (Hierarchy, Elements, u32, u32) {
+        let el = grid_elements(faces, 4);
+        let mut h = Hierarchy::build(faces, &el, |_| true, 0.0);
+        h.set_boxes(faces, &el);
+        let [a, b] = h.nodes[0].kids;
+        let (r, s) = if h.nodes[a as usize].face == 0 {
+            (a, b)
+        } else {
+            (b, a)
+        };
+        (h, el, r, s)
+    }
+
     #[test]
     fn exact_and_estimated_factors_agree_far_away_and_bound_holds() {
         let v = DVec3::new;
@@ -223,25 +255,88 @@ mod test {
             DVec3::ZERO,
         );
         let faces = [bottom, top];
-        let el = grid_elements(&faces, 4);
-        let mut h = Hierarchy::build(&faces, &el, |_| true, 0.0);
-        h.set_boxes(&faces, &el);
-        let [a, b] = h.nodes[0].kids;
-        let (r, s) = if h.nodes[a as usize].face == 0 {
-            (a, b)
-        } else {
-            (b, a)
-        };
+        let (h, el, r, s) = face_nodes(&faces);
         let ends = Ends::new(&h, &faces, r, s);
-        let l = ends.link(&h, &el, r, s, 1.0);
+        let l = ends.link(&h, &el, r, s, 1.0, true);
         // Exact: a point under a small square's centre: F ≈ A/(π·h²).
         let want = 0.01 / (std::f64::consts::PI * 4.0);
         assert!((l.k as f64 / want - 1.0).abs() < 2e-3, "{} vs {want}", l.k);
         assert!(ends.factor_bound() >= l.k as f64 * 0.999);
         // Half visible: half the coefficient.
-        let half = ends.link(&h, &el, r, s, 0.5);
+        let half = ends.link(&h, &el, r, s, 0.5, true);
         assert!((half.k * 2.0 - l.k).abs() < 1e-9);
         assert!((l.u - Vec3::Z).length() < 1e-6);
+    }
+
+    fn unit_square(z: f64, up: bool) -> Face {
+        let v = DVec3::new;
+        let mut p = vec![v(0., 0., z), v(1., 0., z), v(1., 1., z), v(0., 1., z)];
+        if !up {
+            p.reverse();
+        }
+        face(&p, DVec3::ONE, DVec3::ZERO)
+    }
+
+    #[test]
+    fn a_far_source_sends_from_where_it_is_bright() {
+        let faces = [unit_square(0.0, true)];
+        let el = grid_elements(&faces, 4);
+        let mut h = Hierarchy::build(&faces, &el, |_| true, 0.0);
+        h.set_boxes(&faces, &el);
+        let (p, n) = (DVec3::new(0.25, 0.5, 3.0), -DVec3::Z);
+        let leaves = |h: &Hierarchy, left_only: bool| {
+            let mut f = 0.0;
+            for (i, nd) in h.nodes.iter().enumerate() {
+                if nd.is_leaf() && (!left_only || nd.centroid.x < 0.5) {
+                    f += exact_factor(h, &el, p, n, &h.nodes[i], DVec3::Z);
+                }
+            }
+            f
+        };
+        // Evenly lit: the whole square's factor.
+        let even = far_factor(p, n, &h.nodes[0], DVec3::Z);
+        // (Second order: off by about (size / distance)⁴.)
+        assert!((even / leaves(&h, false) - 1.0).abs() < 3e-3, "{even}");
+        // Only its left half lit: the square's mean radiosity is half the left half's, so
+        // the factor that carries it is twice the left half's.
+        let w: Vec<f64> = h
+            .order
+            .iter()
+            .map(|&t| {
+                let c = el.triangles[t as usize]
+                    .iter()
+                    .map(|&v| el.positions[v as usize])
+                    .sum::<DVec3>()
+                    / 3.0;
+                if c.x < 0.5 {
+                    1.0
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        h.weigh(&el, &w);
+        let root = &h.nodes[0];
+        assert!((root.weight - 0.5).abs() < 1e-12);
+        assert!((root.lit_centroid.x - 0.25).abs() < 1e-12);
+        let lit = far_factor(p, n, root, DVec3::Z);
+        let want = 2.0 * leaves(&h, true);
+        assert!((lit / want - 1.0).abs() < 3e-3, "{lit} vs {want}");
+        assert!(lit > even * 1.01, "{lit} vs {even}");
+    }
+
+    #[test]
+    fn a_faint_link_between_near_plates_keeps_a_bounded_factor() {
+        // Two unit squares 5 mm apart, each a node of 32 leaves: a link made between them
+        // without sampling (it carries little) once took a far-field correction that is
+        // unbounded this near, and the solve ran to 1e171.
+        let faces = [unit_square(0.0, true), unit_square(0.005, false)];
+        let (h, el, r, s) = face_nodes(&faces);
+        assert!(!h.nodes[r as usize].is_leaf() && !h.nodes[s as usize].is_leaf());
+        let ends = Ends::new(&h, &faces, r, s);
+        let k = ends.link(&h, &el, r, s, 1.0, false).k;
+        // From the receiver's centre the other plate fills nearly all the hemisphere.
+        assert!(k > 0.98 && k <= 1.0, "{k}");
     }
 }
 
@@ -445,20 +540,31 @@ fn planar_factor(
             let mut pos = s.lo;
             while pos < s.hi {
                 let leaf = &h.nodes[h.leaf_node[pos as usize] as usize];
-                f += exact_factor(h, el, p, n, leaf, ns);
+                f += share(leaf, s) * exact_factor(h, el, p, n, leaf, ns);
                 pos = leaf.hi;
             }
             return f;
         }
-        {
-            return s
-                .kids
-                .iter()
-                .map(|&k| planar_factor(h, el, p, n, &h.nodes[k as usize], ns, depth - 1))
-                .sum();
-        }
+        return s
+            .kids
+            .iter()
+            .map(|&k| {
+                let kid = &h.nodes[k as usize];
+                share(kid, s) * planar_factor(h, el, p, n, kid, ns, depth - 1)
+            })
+            .sum();
     }
     far_factor(p, n, s, ns)
+}
+
+/// How much brighter the part `kid` of `s` is than `s` as a whole (`Hierarchy::weigh`):
+/// a factor to `s` sums its parts' factors, each scaled so.
+fn share(kid: &Node, s: &Node) -> f64 {
+    if s.weight > 0.0 {
+        kid.weight / s.weight
+    } else {
+        1.0
+    }
 }
 
 /// What the mean of a point factor over the planar receiver `r` (normal `nr`) adds to its
@@ -471,14 +577,14 @@ fn receiver_term(r: &Node, nr: DVec3, s: &Node, ns: DVec3) -> f64 {
     if !(r.area > 0.0) {
         return 0.0;
     }
-    let w = s.centroid - r.centroid;
+    let w = s.lit_centroid - r.centroid;
     let q = w.length_squared();
     let (a, b) = (nr.dot(w), -ns.dot(w));
     if a <= 0.0 || b <= 0.0 {
         return 0.0;
     }
     let centre = s.area * a * b / (std::f64::consts::PI * q * q);
-    s.area / r.area * far_factor(s.centroid, ns, r, nr) - centre
+    s.area / r.area * kernel_mean(s.lit_centroid, ns, r.area, r.centroid, &r.moment, nr) - centre
 }
 
 /// Form factor from the point `p` (normal `n`) to a far planar node `s` (normal `ns`): the
@@ -487,16 +593,22 @@ fn receiver_term(r: &Node, nr: DVec3, s: &Node, ns: DVec3) -> f64 {
 /// the disc estimate `A·cosθ·cosθs / (π·d² + A)` is right for a disc facing `p` head-on
 /// but errs low by up to `A / (π·d²)` for tilted pairs (a wall beside a floor).
 pub fn far_factor(p: DVec3, n: DVec3, s: &Node, ns: DVec3) -> f64 {
+    kernel_mean(p, n, s.area, s.lit_centroid, &s.lit_moment, ns)
+}
+
+/// The kernel's mean over a planar patch of area `area`, centroid `c` and second moment
+/// `moment`, times its area: `far_factor`'s second-order estimate.
+fn kernel_mean(p: DVec3, n: DVec3, area: f64, c: DVec3, moment: &[f64; 6], ns: DVec3) -> f64 {
     // For x on the source's plane the kernel is h·(n·w)/|w|⁴, w = x − p, with the
     // height h = −ns·w the same for every x.
-    let w = s.centroid - p;
+    let w = c - p;
     let h = -ns.dot(w);
     if h <= 0.0 {
         return 0.0;
     }
     let a = n.dot(w);
     let q = w.length_squared();
-    let [xx, yy, zz, xy, xz, yz] = s.moment;
+    let [xx, yy, zz, xy, xz, yz] = *moment;
     let mv = |v: DVec3| {
         DVec3::new(
             xx * v.x + xy * v.y + xz * v.z,
@@ -509,5 +621,5 @@ pub fn far_factor(p: DVec3, n: DVec3, s: &Node, ns: DVec3) -> f64 {
     let q3 = q * q * q;
     let k0 = h * a / (q * q);
     let hess = h * (-8.0 * n.dot(mw) / q3 - 4.0 * a * trace / q3 + 24.0 * a * w.dot(mw) / (q3 * q));
-    (s.area * (k0 + 0.5 * hess) / std::f64::consts::PI).max(0.0)
+    (area * (k0 + 0.5 * hess) / std::f64::consts::PI).max(0.0)
 }

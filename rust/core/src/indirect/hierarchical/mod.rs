@@ -100,6 +100,7 @@ pub fn indirect(
         return Ok(result);
     }
 
+    h.weigh(el, &radiosity_estimate(&h, &leaves, emitted_power));
     let b_max = radiosity_bounds(&h, &leaves, emitted_power);
     let b_range = first_radiosity_range(&h, &leaves);
     let max_links = LINKS_PER_LEAF * nl as u64 + LINK_FLOOR;
@@ -214,11 +215,7 @@ fn leaf_inputs(scene: &Scene, el: &Elements, direct: &[DVec3], h: &Hierarchy) ->
 /// surfaces only by bounces, and they must refine too).
 fn radiosity_bounds(h: &Hierarchy, leaves: &Leaves, emitted_power: f64) -> Vec<f64> {
     let area = h.nodes[0].area.max(1e-300);
-    let rho_mean = (0..h.order.len())
-        .map(|i| leaves.albedo[i] * h.area[i])
-        .sum::<DVec3>()
-        / area;
-    let bounce = emitted_power / area / (1.0 - rho_mean.max_element().min(0.95));
+    let bounce = emitted_power / area / (1.0 - mean_albedo(h, leaves).max_element().min(0.95));
     let mut b = vec![0.0; h.nodes.len()];
     for i in (0..h.nodes.len()).rev() {
         let n = &h.nodes[i];
@@ -234,6 +231,21 @@ fn radiosity_bounds(h: &Hierarchy, leaves: &Leaves, emitted_power: f64) -> Vec<f
         };
     }
     b
+}
+
+/// Per leaf position, an estimate of its radiosity over the solve (channels summed): its
+/// first radiosity plus its albedo times the mean irradiance the bounces give a closed scene
+/// (the emitted power over the area, over 1 − ρ), for `Hierarchy::weigh`.
+fn radiosity_estimate(h: &Hierarchy, leaves: &Leaves, emitted_power: f64) -> Vec<f64> {
+    let area = h.nodes.first().map_or(0.0, |n| n.area).max(1e-300);
+    let rho = mean_albedo(h, leaves).element_sum() / 3.0;
+    let bounce = emitted_power / area / (1.0 - rho).max(0.05) / 3.0;
+    (0..h.order.len())
+        .map(|p| {
+            let first = leaves.albedo[p] * leaves.direct[p] + leaves.emitted[p];
+            first.element_sum() + leaves.albedo[p].element_sum() * bounce
+        })
+        .collect()
 }
 
 /// Per node, how much its leaves' first radiosity (reflected direct light plus emission,
@@ -260,21 +272,25 @@ fn first_radiosity_range(h: &Hierarchy, leaves: &Leaves) -> Vec<f64> {
     lo.iter().zip(&hi).map(|(l, h)| (h - l).max(0.0)).collect()
 }
 
+/// The leaves' albedo, area-weighted (0 without area).
+fn mean_albedo(h: &Hierarchy, leaves: &Leaves) -> DVec3 {
+    let area = h.nodes.first().map_or(0.0, |n| n.area);
+    if !(area > 0.0) {
+        return DVec3::ZERO;
+    }
+    (0..h.order.len())
+        .map(|i| leaves.albedo[i] * h.area[i])
+        .sum::<DVec3>()
+        / area
+}
+
 /// Cohen et al.'s ambient term for what the sweeps left: the last sweep added `delta`
 /// (area-weighted mean irradiance); each later one would add about ρ times the one before.
 /// The final gather at the vertices is one of those (it gathers the radiosity the last
 /// sweep's irradiance gives), so what is left starts at ρ²: ρ²/(1 − ρ) times `delta`.
 /// Assumes a closed scene.
 fn ambient(h: &Hierarchy, leaves: &Leaves, delta: DVec3) -> DVec3 {
-    let area = h.nodes[0].area;
-    if !(area > 0.0) {
-        return DVec3::ZERO;
-    }
-    let rho = (0..h.order.len())
-        .map(|i| leaves.albedo[i] * h.area[i])
-        .sum::<DVec3>()
-        / area;
-    let rho = rho.min(DVec3::splat(0.999));
+    let rho = mean_albedo(h, leaves).min(DVec3::splat(0.999));
     delta.max(DVec3::ZERO) * rho * rho / (DVec3::ONE - rho)
 }
 

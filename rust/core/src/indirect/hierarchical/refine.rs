@@ -1,7 +1,8 @@
 //! Link refinement (Hanrahan, Salzman & Aupperle 1991, with clusters as Smits, Arvo &
 //! Greenberg 1994): starting from the root linked to itself, a link is split, by splitting the
 //! larger of its two nodes, while
-//! - the two are in each other's near field (closer than their sizes add up), or
+//! - the two are in each other's near field (closer than twice their sizes added up) and
+//!   the power is over `eps / NEAR_POWER`, or
 //! - the error it could make, `B_s · F · A_r · (size / distance)²` (the source's largest
 //!   radiosity, a form factor that errs high, the receiver's area, and the relative error
 //!   of a point-to-disc factor), is over `eps`, or
@@ -21,8 +22,15 @@ use super::link::{Ends, Link};
 use super::visibility::Visibility;
 use crate::progress::Progress;
 
-/// Near field: nodes whose centroids are closer than this times the sum of their radii.
-const NEAR: f64 = 1.0;
+/// Near field: nodes whose centroids are closer than this times the sum of their radii are
+/// split down to leaves, whose factors are exact (`link::exact_pair`); a factor between
+/// larger nodes that near would need sampling over the receiver, which cost most of the
+/// refinement.
+const NEAR: f64 = 2.0;
+/// Near pairs carrying under `eps / NEAR_POWER` are linked where they are, with the factor
+/// at the receiver's centroid: in clutter most near pairs are small faces lit by little,
+/// and splitting them all down to leaves cost more than the rest of the solve.
+const NEAR_POWER: f64 = 1024.0;
 /// Links whose shaft holds a listed blocker are split while their power exceeds
 /// `eps / PARTIAL`.
 const PARTIAL: f64 = 16.0;
@@ -36,7 +44,7 @@ const VARY_REL: f64 = 0.1;
 const VARY_POWER: f64 = 64.0;
 /// Sources whose first radiosity varies by more than `VARY_REL` are split for links
 /// carrying over `eps / SOURCE_VARY_POWER` of that variation.
-const SOURCE_VARY_POWER: f64 = 1024.0;
+const SOURCE_VARY_POWER: f64 = 64.0;
 /// Pairs with fewer leaves than this (receiver × source) are refined on one thread.
 const SERIAL_BELOW: u64 = 1 << 12;
 
@@ -97,7 +105,7 @@ impl<'a> Refiner<'a> {
     pub fn run(&self) -> Refined {
         let mut links = Vec::new();
         if !self.vis.h.nodes.is_empty() {
-            self.refine(0, 0, &mut links);
+            self.refine(0, 0, None, &mut links);
         }
         Refined {
             links,
@@ -127,7 +135,7 @@ impl<'a> Refiner<'a> {
         }
     }
 
-    fn refine(&self, r: u32, s: u32, out: &mut Vec<Link>) {
+    fn refine(&self, r: u32, s: u32, inherited: Option<&[u32]>, out: &mut Vec<Link>) {
         if self.stop.load(Ordering::Relaxed) {
             return;
         }
@@ -138,7 +146,7 @@ impl<'a> Refiner<'a> {
                 return;
             }
             let [a, b] = rn.kids;
-            return self.split(&[(a, a), (a, b), (b, a), (b, b)], out);
+            return self.split(&[(a, a), (a, b), (b, a), (b, b)], inherited, out);
         }
         if rn.is_planar() && rn.face == sn.face {
             self.settle(rn, sn);
@@ -174,8 +182,13 @@ impl<'a> Refiner<'a> {
         // link would make, not the light it carries, decides.
         let spread = ((rn.radius() + sn.radius()) / dist.max(1e-300)).min(1.0);
         let error = power * spread * spread;
+        let faint = power <= self.eps / NEAR_POWER;
+        let near = near && !faint;
         if !both_leaves && (near || error > self.eps) && !self.over_budget() {
-            return self.split_larger(r, s, out);
+            if near {
+            } else {
+            }
+            return self.split_larger(r, s, inherited, out);
         }
         // The link gives every point of the receiver its mean factor: where the factor
         // varies over the receiver (a wall whose part by a corner sees less of the far
@@ -194,55 +207,60 @@ impl<'a> Refiner<'a> {
                 let carried = self.b_max[s as usize] * f0 * rn.area;
                 if vary > VARY_REL * f0 && carried > self.eps / VARY_POWER {
                     let [a, b] = rn.kids;
-                    return self.split(&[(a, s), (b, s)], out);
+                    return self.split(&[(a, s), (b, s)], inherited, out);
                 }
             }
         }
-        // The source sends its mean radiosity times the mean share of its light that reaches
-        // the receiver: where the radiosity varies over the source, the share does too, and
-        // the product of means loses light coherently over the links (0.34 % of each bounce
-        // in a lit empty room at eps / VARY_POWER, the empty room 1.1 % low). Split the
-        // source down to a finer bound.
+        // The source sends its mean radiosity times the share of its light that reaches the
+        // receiver: where the radiosity varies over the source, the share does too. The
+        // factor is taken from where the source is bright (`Hierarchy::weigh`), but that is a
+        // guess made before the solve; where the variation carries much, split the source.
         if !sn.is_leaf() && !self.over_budget() {
             let carried = self.b_range[s as usize] * ends.factor_bound() * rn.area;
             if self.b_range[s as usize] > VARY_REL * self.b_max[s as usize]
                 && carried > self.eps / SOURCE_VARY_POWER
             {
                 let [a, b] = sn.kids;
-                return self.split(&[(r, a), (r, b)], out);
+                return self.split(&[(r, a), (r, b)], inherited, out);
             }
         }
-        let blockers = self.vis.blockers(rn, sn);
+        // A faint pair is never split, so its shaft list would only spare it a few rays;
+        // in clutter most shaft queries give up past their cap anyway (room-245: 2.1M of
+        // 2.9M), and the query costs more than the rays.
+        let blockers = match inherited {
+            Some(l) => Some(self.vis.blockers_among(rn, sn, l)),
+            None if faint => None,
+            None => self.vis.blockers(rn, sn),
+        };
         // A shaft with something in it is treated as partly blocked without a ray: a few
         // rays can miss a small blocker near one end (a leg under a seat).
         let listed = blockers.as_ref().is_some_and(|l| !l.is_empty());
         if listed && !both_leaves && power > self.eps / PARTIAL && !self.over_budget() {
-            return self.split_larger(r, s, out);
+            return self.split_larger(r, s, blockers.as_deref(), out);
         }
         // Something may be in the way of a link carrying much: sample it more densely.
         let rays = if error > self.eps / 4.0 { self.rays } else { 4 };
-        let (v, cast) = self.vis.fraction_among(rn, sn, blockers.as_deref(), rays);
+        // A pair that any blocked segment would split needs no more rays after the first.
+        let splits = !both_leaves && power > self.eps / SHADOW;
+        let (v, cast) = self
+            .vis
+            .fraction_among(rn, sn, blockers.as_deref(), rays, splits);
         if cast > 0 {
             self.rays_cast.fetch_add(cast as u64, Ordering::Relaxed);
         }
         // Partly hidden: the shadow varies over the receiver, and a mean over it would
         // light its dark part (the seat right above a leg). Split the receiver first.
-        if v < 1.0
-            && (v > 0.0 || cast > 0)
-            && !both_leaves
-            && power > self.eps / SHADOW
-            && !self.over_budget()
-        {
+        if v < 1.0 && (v > 0.0 || cast > 0) && splits && !self.over_budget() {
             return if rn.is_leaf() {
-                self.split_larger(r, s, out)
+                self.split_larger(r, s, blockers.as_deref(), out)
             } else {
                 let [a, b] = rn.kids;
-                self.split(&[(a, s), (b, s)], out)
+                self.split(&[(a, s), (b, s)], blockers.as_deref(), out)
             };
         }
         self.settle(rn, sn);
         if v > 0.0 {
-            let link = ends.link(h, self.vis.el, r, s, v);
+            let link = ends.link(h, self.vis.el, r, s, v, !faint);
             if link.k > 0.0 || ends.factor_bound() > 0.0 {
                 out.push(link);
                 let n = self.links.fetch_add(1, Ordering::Relaxed) + 1;
@@ -265,27 +283,27 @@ impl<'a> Refiner<'a> {
         over
     }
 
-    fn split_larger(&self, r: u32, s: u32, out: &mut Vec<Link>) {
+    fn split_larger(&self, r: u32, s: u32, inherited: Option<&[u32]>, out: &mut Vec<Link>) {
         let (rn, sn) = (self.node(r), self.node(s));
         let split_r = !rn.is_leaf() && (sn.is_leaf() || rn.area >= sn.area);
         if split_r {
             let [a, b] = rn.kids;
-            self.split(&[(a, s), (b, s)], out)
+            self.split(&[(a, s), (b, s)], inherited, out)
         } else {
             let [a, b] = sn.kids;
-            self.split(&[(r, a), (r, b)], out)
+            self.split(&[(r, a), (r, b)], inherited, out)
         }
     }
 
     /// Refines `pairs` into `out` in their order, in parallel when they are large.
-    fn split(&self, pairs: &[(u32, u32)], out: &mut Vec<Link>) {
+    fn split(&self, pairs: &[(u32, u32)], inherited: Option<&[u32]>, out: &mut Vec<Link>) {
         let size = |&(r, s): &(u32, u32)| {
             let (a, b) = (self.node(r), self.node(s));
             (a.hi - a.lo) as u64 * (b.hi - b.lo) as u64
         };
         if pairs.len() < 2 || pairs.iter().map(size).sum::<u64>() < SERIAL_BELOW {
             for &(r, s) in pairs {
-                self.refine(r, s, out);
+                self.refine(r, s, inherited, out);
             }
             return;
         }
@@ -293,12 +311,12 @@ impl<'a> Refiner<'a> {
         let (mut la, lb) = rayon::join(
             || {
                 let mut v = Vec::new();
-                self.split(a, &mut v);
+                self.split(a, inherited, &mut v);
                 v
             },
             || {
                 let mut v = Vec::new();
-                self.split(b, &mut v);
+                self.split(b, inherited, &mut v);
                 v
             },
         );
