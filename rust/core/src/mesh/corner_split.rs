@@ -10,6 +10,7 @@ use std::hash::BuildHasherDefault;
 use glam::DVec2;
 
 use super::refine::KeyHasher;
+use super::sides::nudge;
 use super::ReceiverMesh;
 use crate::scene::Tolerances;
 
@@ -68,19 +69,11 @@ pub(crate) fn split(m: &mut ReceiverMesh, d0_lines: &[[DVec2; 2]], tol: &Toleran
                 m.positions.len() - 1
             };
             m.triangles[t][k] = id as u32;
-            // Nudge the evaluation point towards the triangle's centroid.
+            // The evaluation point moves towards the triangle's centroid.
             let p = m.positions[v];
             let tri = m.triangles[t].map(|i| m.positions[i as usize]);
-            let c = (tri[0] + tri[1] + tri[2]) / 3.0;
-            let shortest = tri
-                .iter()
-                .map(|q| (*q - p).length())
-                .filter(|d| *d > 0.0)
-                .fold(f64::INFINITY, f64::min);
-            let dir = (c - p).normalize_or_zero();
-            if dir != DVec2::ZERO && shortest.is_finite() {
-                let step = (shortest * 1e-6).max(tol.d0_offset).min(0.25 * shortest);
-                m.eval[id] = p + dir * step;
+            if let Some(q) = nudge(p, std::iter::once(tri), tol) {
+                m.eval[id] = q;
             }
         }
     }

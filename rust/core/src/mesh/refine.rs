@@ -18,10 +18,12 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 use spade::handles::FixedVertexHandle;
-use spade::{Point2, PositionInTriangulation, Triangulation};
+use spade::{Point2, Triangulation};
 
-use super::{corner_split, doubt, extract, Cdt, ReceiverMesh};
-use crate::geom::polygon::orient;
+use super::extract::{components, extract_with, face_index, scale, Components};
+use super::readings::{Kind, View};
+use super::sides::{D0Test, Face};
+use super::{corner_split, doubt, split, Cdt, Label, ReceiverMesh};
 use crate::geom::Frame;
 use crate::regions::relation::Relation;
 use crate::regions::{ReceiverRegions, Region};
@@ -110,7 +112,9 @@ type Cache = HashMap<[u64; 2], (DVec3, [u64; 3]), std::hash::BuildHasherDefault<
 
 /// Refines `cdt` until every element meets `settings.tolerance` or the lower bound, and
 /// returns the element mesh (D0 rows and corners split) with the direct light known at
-/// every vertex.
+/// every vertex. Incremental: components are classified once and kept on the faces
+/// (`Label`); each pass checks only the triangles around the vertices the last pass put in
+/// (and re-screens their neighbours); the receiver is extracted once, at the end.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn refine(
     cdt: &mut Cdt,
@@ -123,239 +127,77 @@ pub(crate) fn refine(
     budget: &AtomicU64,
     progress: &crate::Progress,
 ) -> Result<(ReceiverMesh, RefineStats), BakeError> {
-    let lower = lower_bound(settings);
     let mut stats = RefineStats::default();
     let mut cache = Cache::default();
-    add_frame(cdt);
+    split::add_frame(cdt);
+    let Components {
+        comp,
+        mut regions,
+        mut outside,
+    } = components(cdt, shift, rr);
+    let faces: Vec<Face> = cdt.fixed_inner_faces().collect();
+    for f in faces {
+        *cdt.face_data_mut(f) = Label(comp[face_index(f)]);
+    }
+    drop(comp);
+    let test = D0Test::new(rr, scale(cdt, shift), shift);
+    let mut kinds: Vec<Kind> = Vec::new();
+    let mut brightest = DVec3::ZERO;
+    let mut check: Vec<Face> = {
+        let outside = &outside;
+        cdt.fixed_inner_faces()
+            .filter(|f| !outside[cdt.face(*f).data().0 as usize])
+            .collect()
+    };
+    stats.elements_before = check.len() as u64;
     loop {
         progress.check()?;
-        let mut m = extract(cdt, shift, rr, frame, false, tol);
-        corner_split::split(&mut m, &rr.d0_lines, tol);
-        let nv = m.positions.len();
-        if stats.passes == 0 {
-            stats.elements_before = m.triangles.len() as u64;
-        }
-
-        // Vertex values: each with the regions of the triangles around it (after the D0 and
-        // corner splits, only those of its own side).
-        let missing: Vec<usize> = (0..nv)
-            .filter(|&v| !cache.contains_key(&key(m.eval[v])))
-            .collect();
-        let mut slot = vec![u32::MAX; nv];
-        for (k, &v) in missing.iter().enumerate() {
-            slot[v] = k as u32;
-        }
-        let mut around: Vec<Vec<u32>> = vec![Vec::new(); missing.len()];
-        for (t, tri) in m.triangles.iter().enumerate() {
-            for &v in tri {
-                let k = slot[v as usize];
-                if k == u32::MAX {
-                    continue;
-                }
-                let r = m.tri_region[t];
-                if !around[k as usize].contains(&r) {
-                    around[k as usize].push(r);
-                }
-            }
-        }
-        let values: Vec<_> = missing
-            .par_iter()
-            .zip(&around)
-            .map(|(&v, around)| {
-                let regs: Vec<&Region> = around.iter().map(|&r| &m.regions[r as usize]).collect();
-                light(m.eval[v], &regs)
-            })
-            .collect();
-        stats.evaluations += values.len() as u64;
-        for (&v, val) in missing.iter().zip(values) {
-            cache.insert(key(m.eval[v]), val);
-        }
-        progress.check()?;
-        let vals: Vec<DVec3> = m.eval.iter().map(|p| cache[&key(*p)].0).collect();
-        let value = |v: u32| vals[v as usize];
-        let floor = vals.iter().fold(DVec3::ZERO, |a, b| a.max(*b)) * FLOOR;
-
+        let view = View {
+            cdt,
+            shift,
+            tol,
+            regions: &regions,
+            outside: &outside,
+            test: &test,
+        };
+        let found = check_faces(
+            &view,
+            &check,
+            &mut kinds,
+            &mut cache,
+            &mut brightest,
+            settings,
+            light,
+            &mut stats,
+            progress,
+        )?;
         let used = budget.load(Ordering::Relaxed);
         if stats.passes >= MAX_PASSES as u64 || used >= settings.max_elements {
-            return Ok(finish(m, &cache, stats));
+            break;
         }
-
-        // Samples: edge midpoints (edges at least twice the lower bound) and centroids
-        // (elements whose edges are all splittable), at the mean of the evaluation points so
-        // that a sample beside a D0 row or a corner lies on its element's side.
-        // Checked exactly only where the vertex values leave the element in doubt.
-        let allowed = |t: usize| {
-            let least = m.triangles[t]
-                .iter()
-                .map(|&v| value(v).abs())
-                .fold(DVec3::splat(f64::INFINITY), DVec3::min);
-            (least + floor) * (settings.tolerance * SAFETY)
+        let Some((mut edges, centroids)) = found else {
+            break;
         };
-        let doubtful = doubt::doubtful(&m.positions, &m.triangles, &m.tri_region, &value, &allowed);
-        let mut samples: Vec<Sample> = Vec::new();
-        for (t, tri) in m.triangles.iter().enumerate() {
-            if !doubtful[t] {
-                continue;
-            }
-            // In umbra of every light the exact light is nothing, and so are the vertices
-            // (those on its border lie where the light comes in continuously, from nothing,
-            // or on a D0 row whose copy on this side is dark): nothing to check.
-            let region = &m.regions[m.tri_region[t] as usize];
-            if region.relations.iter().all(|r| *r == Relation::Umbra) {
-                continue;
-            }
-            let p = tri.map(|v| m.positions[v as usize]);
-            let mut splittable = 0;
-            for k in 0..3 {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                if (p[k] - p[(k + 1) % 3]).length() < 2.0 * lower {
-                    continue;
-                }
-                splittable += 1;
-                samples.push(Sample {
-                    tri: t as u32,
-                    at: 0.5 * (m.eval[a as usize] + m.eval[b as usize]),
-                    interp: 0.5 * (value(a) + value(b)),
-                    split: Split::Edge(a, b),
-                });
-            }
-            if splittable == 3 {
-                let c = tri.map(|v| m.eval[v as usize]);
-                samples.push(Sample {
-                    tri: t as u32,
-                    at: (c[0] + c[1] + c[2]) / 3.0,
-                    interp: (value(tri[0]) + value(tri[1]) + value(tri[2])) / 3.0,
-                    split: Split::Centroid((p[0] + p[1] + p[2]) / 3.0),
-                });
-                // In penumbra the light kinks along critical lines that no constraint
-                // follows, and a kink inside an element errs most beside it, not at the
-                // midpoints: three more points, halfway from the centroid to each corner.
-                if region.relations.contains(&Relation::Penumbra) {
-                    let centre = (p[0] + p[1] + p[2]) / 3.0;
-                    let centre_eval = (c[0] + c[1] + c[2]) / 3.0;
-                    let centre_value = (value(tri[0]) + value(tri[1]) + value(tri[2])) / 3.0;
-                    for k in 0..3 {
-                        samples.push(Sample {
-                            tri: t as u32,
-                            at: 0.5 * (centre_eval + c[k]),
-                            interp: 0.5 * (centre_value + value(tri[k])),
-                            split: Split::Centroid(0.5 * (centre + p[k])),
-                        });
-                    }
-                }
-            }
-        }
-        // A midpoint may become a vertex, whose value is then this one: on an edge between
-        // two regions it takes both (a lit region's shortcut is right only inside it).
-        let mut tri_of_edge: HashMap<(u32, u32), u32, std::hash::BuildHasherDefault<KeyHasher>> =
-            HashMap::with_capacity_and_hasher(3 * m.triangles.len(), Default::default());
-        for (t, tri) in m.triangles.iter().enumerate() {
-            for k in 0..3 {
-                tri_of_edge.insert((tri[k], tri[(k + 1) % 3]), t as u32);
-            }
-        }
-        let mut todo: Vec<(DVec2, u32, u32)> = samples
-            .iter()
-            .filter(|s| !cache.contains_key(&key(s.at)))
-            .map(|s| {
-                let other = match s.split {
-                    Split::Edge(a, b) => tri_of_edge.get(&(b, a)).copied().unwrap_or(s.tri),
-                    Split::Centroid(_) => s.tri,
-                };
-                (s.at, s.tri, other)
-            })
-            .collect();
-        todo.sort_unstable_by_key(|(p, _, _)| key(*p));
-        todo.dedup_by_key(|(p, _, _)| key(*p));
-        let values: Vec<_> = todo
-            .par_iter()
-            .map(|&(q, t, o)| {
-                let (rt, ro) = (m.tri_region[t as usize], m.tri_region[o as usize]);
-                if rt == ro {
-                    light(q, &[&m.regions[rt as usize]])
-                } else {
-                    light(q, &[&m.regions[rt as usize], &m.regions[ro as usize]])
-                }
-            })
-            .collect();
-        stats.evaluations += values.len() as u64;
-        for (&(q, _, _), val) in todo.iter().zip(values) {
-            cache.insert(key(q), val);
-        }
-        progress.check()?;
-
-        let fails = |s: &Sample| {
-            let exact = cache[&key(s.at)].0;
-            let err = (s.interp - exact).abs();
-            let allowed = (exact.abs() + floor) * (settings.tolerance * SAFETY);
-            err.cmpgt(allowed).any()
-        };
-        let mut edges: Vec<(u32, u32)> = Vec::new();
-        let mut centroids: Vec<DVec2> = Vec::new();
-        let mut edge_failed = vec![false; m.triangles.len()];
-        for s in &samples {
-            if let Split::Edge(a, b) = s.split {
-                if fails(s) {
-                    edge_failed[s.tri as usize] = true;
-                    edges.push((a, b));
-                }
-            }
-        }
-        for s in &samples {
-            if let Split::Centroid(c) = s.split {
-                // One interior point per element and pass.
-                if !edge_failed[s.tri as usize] && fails(s) {
-                    edge_failed[s.tri as usize] = true;
-                    centroids.push(c);
-                }
-            }
-        }
-        if edges.is_empty() && centroids.is_empty() {
-            return Ok(finish(m, &cache, stats));
-        }
-
-        // Back to the CDT's vertices: copies made by the D0 and corner splits stand for the
-        // CDT vertex at their position.
-        let handle_at: HashMap<
-            [u64; 2],
-            FixedVertexHandle,
-            std::hash::BuildHasherDefault<KeyHasher>,
-        > = cdt
-            .fixed_vertices()
-            .map(|h| {
-                let p = cdt.vertex(h).position();
-                (key(DVec2::new(p.x, p.y) - shift), h)
-            })
-            .collect();
-        // Directed as in their triangle (counter-clockwise), so that the triangle that failed
-        // lies on the left.
-        let mut pairs: Vec<(FixedVertexHandle, FixedVertexHandle)> = edges
-            .iter()
-            .filter_map(|&(a, b)| {
-                let ha = *handle_at.get(&key(m.positions[a as usize]))?;
-                let hb = *handle_at.get(&key(m.positions[b as usize]))?;
-                (ha != hb).then_some((ha, hb))
-            })
-            .collect();
-        pairs.sort_unstable();
-        pairs.dedup();
+        edges.sort_unstable();
+        edges.dedup();
         let before = cdt.num_vertices();
+        let mut touched = Vec::new();
         let room = settings.max_elements.saturating_sub(used) as usize;
-        for (k, &(a, b)) in pairs.iter().enumerate() {
+        for (k, &(a, b)) in edges.iter().enumerate() {
             if k % 1024 == 0 {
                 progress.check()?;
             }
             if cdt.num_vertices() - before >= room {
                 break;
             }
-            split_edge(cdt, a, b);
+            split::split_edge(cdt, a, b, &mut touched);
         }
         for &c in &centroids {
             if cdt.num_vertices() - before >= room {
                 break;
             }
             let c = c + shift;
-            insert_inside(cdt, Point2::new(c.x, c.y));
+            split::insert_inside(cdt, Point2::new(c.x, c.y));
         }
         let added = (cdt.num_vertices() - before) as u64;
         budget.fetch_add(added, Ordering::Relaxed);
@@ -364,25 +206,342 @@ pub(crate) fn refine(
         // Every split was refused (kinked constraints, rounding): the next pass would find
         // the same elements.
         if added == 0 {
-            return Ok(finish(
-                extract_split(cdt, shift, rr, frame, tol),
-                &cache,
-                stats,
-            ));
+            break;
+        }
+        touched.extend((before..cdt.num_vertices()).map(FixedVertexHandle::from_index));
+        touched.sort_unstable();
+        touched.dedup();
+        let around = label_new_faces(cdt, &touched, rr, shift, &mut regions, &mut outside);
+        // The triangles around what changed are checked again, and their neighbours too,
+        // whose screening sees new gradients.
+        let view = View {
+            cdt,
+            shift,
+            tol,
+            regions: &regions,
+            outside: &outside,
+            test: &test,
+        };
+        let mut mark = vec![false; cdt.num_all_faces()];
+        check.clear();
+        for &f in &around {
+            if view.inside(f) && !std::mem::replace(&mut mark[f.index()], true) {
+                check.push(f);
+            }
+        }
+        for k in 0..check.len() {
+            let f = check[k];
+            for n in view.neighbours(f).collect::<Vec<_>>() {
+                if view.inside(n) && !std::mem::replace(&mut mark[n.index()], true) {
+                    check.push(n);
+                }
+            }
         }
     }
+    debug_assert!(cdt.inner_faces().all(|f| f.data().0 != u32::MAX));
+    let comp: Vec<u32> = cdt.inner_faces().map(|f| f.data().0).collect();
+    let mut m = extract_with(
+        cdt,
+        shift,
+        rr,
+        frame,
+        tol,
+        Components {
+            comp,
+            regions,
+            outside,
+        },
+    );
+    corner_split::split(&mut m, &rr.d0_lines, tol);
+    Ok(finish(m, &cache, stats))
 }
 
-fn extract_split(
-    cdt: &Cdt,
-    shift: DVec2,
+/// Gives the faces around `touched` that spade made (still unlabelled) the component of a
+/// labelled neighbour across an edge that is not a constraint (insertions and flips stay in
+/// one component); returns every face around `touched`.
+fn label_new_faces(
+    cdt: &mut Cdt,
+    touched: &[FixedVertexHandle],
     rr: &ReceiverRegions,
-    frame: &Frame,
-    tol: &Tolerances,
-) -> ReceiverMesh {
-    let mut m = extract(cdt, shift, rr, frame, false, tol);
-    corner_split::split(&mut m, &rr.d0_lines, tol);
-    m
+    shift: DVec2,
+    regions: &mut Vec<Region>,
+    outside: &mut Vec<bool>,
+) -> Vec<Face> {
+    let mut around: Vec<Face> = Vec::new();
+    for &v in touched {
+        for e in cdt.vertex(v).out_edges() {
+            if let Some(f) = e.face().as_inner() {
+                around.push(f.fix());
+            }
+        }
+    }
+    around.sort_unstable();
+    around.dedup();
+    let mut fresh: Vec<Face> = around
+        .iter()
+        .copied()
+        .filter(|&f| cdt.face(f).data().0 == u32::MAX)
+        .collect();
+    while !fresh.is_empty() {
+        let mut next = Vec::new();
+        for &f in &fresh {
+            let known = cdt.face(f).adjacent_edges().into_iter().find_map(|e| {
+                if e.is_constraint_edge() {
+                    return None;
+                }
+                let l = e.rev().face().as_inner()?.data().0;
+                (l != u32::MAX).then_some(l)
+            });
+            match known {
+                Some(l) => *cdt.face_data_mut(f) = Label(l),
+                None => next.push(f),
+            }
+        }
+        if next.len() == fresh.len() {
+            // No labelled neighbour (not seen from spade's operations): classified on its own.
+            for &f in &next {
+                let face = cdt.face(f);
+                let c = face.center();
+                let out = face
+                    .adjacent_edges()
+                    .iter()
+                    .any(|e| !e.is_constraint_edge() && e.rev().face().is_outer());
+                regions.push(if out {
+                    Region::default()
+                } else {
+                    rr.classify(DVec2::new(c.x, c.y) - shift)
+                });
+                outside.push(out);
+                *cdt.face_data_mut(f) = Label(regions.len() as u32 - 1);
+            }
+            break;
+        }
+        fresh = next;
+    }
+    around
+}
+
+/// Edges to split (their vertices) and interior points to insert, found on the faces
+/// `check`; `None` when all pass.
+type Splits = (Vec<(FixedVertexHandle, FixedVertexHandle)>, Vec<DVec2>);
+
+/// One pass of checks: the light at the corners of `check` and of their neighbours (for
+/// the screening), then at the samples of the faces in doubt.
+#[allow(clippy::too_many_arguments)]
+fn check_faces(
+    view: &View<'_>,
+    check: &[Face],
+    kinds: &mut Vec<Kind>,
+    cache: &mut Cache,
+    brightest: &mut DVec3,
+    settings: &Settings,
+    light: &LightAt,
+    stats: &mut RefineStats,
+    progress: &crate::Progress,
+) -> Result<Option<Splits>, BakeError> {
+    let cdt = view.cdt;
+    let lower = lower_bound(settings);
+    // Faces whose corner values are needed: those checked and their neighbours.
+    let mut slot = vec![u32::MAX; cdt.num_all_faces()];
+    let mut faces: Vec<Face> = Vec::with_capacity(check.len() * 2);
+    for &f in check {
+        slot[f.index()] = faces.len() as u32;
+        faces.push(f);
+    }
+    for &f in check {
+        for n in view.neighbours(f) {
+            if slot[n.index()] == u32::MAX {
+                slot[n.index()] = faces.len() as u32;
+                faces.push(n);
+            }
+        }
+    }
+    kinds.resize(cdt.num_vertices(), Kind::Unknown);
+    for &f in &faces {
+        for v in view.vertices(f) {
+            if kinds[v.index()] == Kind::Unknown {
+                kinds[v.index()] = view.kind(v);
+            }
+        }
+    }
+    let kinds = &*kinds;
+    let readings: Vec<[(DVec2, Vec<u32>); 3]> = faces
+        .par_iter()
+        .map(|&f| {
+            let vs = view.vertices(f);
+            [0, 1, 2].map(|k| view.reading(f, k, kinds[vs[k].index()]))
+        })
+        .collect();
+    let mut todo: Vec<(DVec2, &[u32])> = readings
+        .iter()
+        .flatten()
+        .filter(|(p, _)| !cache.contains_key(&key(*p)))
+        .map(|(p, l)| (*p, l.as_slice()))
+        .collect();
+    todo.sort_unstable_by_key(|(p, _)| key(*p));
+    todo.dedup_by_key(|(p, _)| key(*p));
+    let values: Vec<_> = todo
+        .par_iter()
+        .map(|&(p, labels)| {
+            let regs: Vec<&Region> = labels.iter().map(|&l| &view.regions[l as usize]).collect();
+            light(p, &regs)
+        })
+        .collect();
+    stats.evaluations += values.len() as u64;
+    for (&(p, _), val) in todo.iter().zip(values) {
+        *brightest = brightest.max(val.0);
+        cache.insert(key(p), val);
+    }
+    progress.check()?;
+    let floor = *brightest * FLOOR;
+    let vals: Vec<[DVec3; 3]> = readings
+        .iter()
+        .map(|r| r.clone().map(|(p, _)| cache[&key(p)].0))
+        .collect();
+    let tris: Vec<[DVec2; 3]> = faces.iter().map(|&f| view.triangle(f)).collect();
+    let grads: Vec<_> = tris
+        .iter()
+        .zip(&vals)
+        .map(|(p, v)| doubt::gradient(*p, *v))
+        .collect();
+
+    // Samples: edge midpoints (edges at least twice the lower bound) and centroids
+    // (elements whose edges are all splittable), at the mean of the reading points so that
+    // a sample beside a D0 row or a corner lies on its element's side. Checked exactly only
+    // where the vertex values leave the element in doubt.
+    let mut samples: Vec<Sample> = Vec::new();
+    for (i, &f) in check.iter().enumerate() {
+        // In umbra of every light the exact light is nothing, and so are the vertices
+        // (those on its border lie where the light comes in continuously, from nothing,
+        // or on a D0 row whose copy on this side is dark): nothing to check.
+        let label = view.label(f);
+        let region = &view.regions[label as usize];
+        if region.relations.iter().all(|r| *r == Relation::Umbra) {
+            continue;
+        }
+        let value = vals[i];
+        let least = value
+            .iter()
+            .map(|v| v.abs())
+            .fold(DVec3::splat(f64::INFINITY), DVec3::min);
+        let allowed = (least + floor) * (settings.tolerance * SAFETY);
+        let neighbours: Vec<_> = view
+            .neighbours(f)
+            .map(|n| {
+                let j = slot[n.index()] as usize;
+                let t = tris[j];
+                ((t[0] + t[1] + t[2]) / 3.0, grads[j])
+            })
+            .collect();
+        let p = tris[i];
+        if !doubt::doubtful(p, value, &neighbours, allowed) {
+            continue;
+        }
+        let vs = view.vertices(f);
+        let c = readings[i].clone().map(|(q, _)| q);
+        let edges = cdt.face(f).adjacent_edges();
+        let mut splittable = 0;
+        for k in 0..3 {
+            if (p[k] - p[(k + 1) % 3]).length() < 2.0 * lower {
+                continue;
+            }
+            splittable += 1;
+            // A midpoint may become a vertex, whose value is then this one: on an edge
+            // between two regions it takes both (a lit region's shortcut is right only
+            // inside it).
+            let other = edges[k]
+                .rev()
+                .face()
+                .as_inner()
+                .map(|g| g.fix())
+                .filter(|&g| view.inside(g))
+                .map_or(label, |g| view.label(g));
+            samples.push(Sample {
+                face: i as u32,
+                at: 0.5 * (c[k] + c[(k + 1) % 3]),
+                interp: 0.5 * (value[k] + value[(k + 1) % 3]),
+                other,
+                split: Split::Edge(vs[k], vs[(k + 1) % 3]),
+            });
+        }
+        if splittable == 3 {
+            samples.push(Sample {
+                face: i as u32,
+                at: (c[0] + c[1] + c[2]) / 3.0,
+                interp: (value[0] + value[1] + value[2]) / 3.0,
+                other: label,
+                split: Split::Centroid((p[0] + p[1] + p[2]) / 3.0),
+            });
+            // In penumbra the light kinks along critical lines that no constraint
+            // follows, and a kink inside an element errs most beside it, not at the
+            // midpoints: three more points, halfway from the centroid to each corner.
+            if region.relations.contains(&Relation::Penumbra) {
+                let centre = (p[0] + p[1] + p[2]) / 3.0;
+                let centre_eval = (c[0] + c[1] + c[2]) / 3.0;
+                let centre_value = (value[0] + value[1] + value[2]) / 3.0;
+                for k in 0..3 {
+                    samples.push(Sample {
+                        face: i as u32,
+                        at: 0.5 * (centre_eval + c[k]),
+                        interp: 0.5 * (centre_value + value[k]),
+                        other: label,
+                        split: Split::Centroid(0.5 * (centre + p[k])),
+                    });
+                }
+            }
+        }
+    }
+    let mut todo: Vec<(DVec2, u32, u32)> = samples
+        .iter()
+        .filter(|s| !cache.contains_key(&key(s.at)))
+        .map(|s| (s.at, view.label(check[s.face as usize]), s.other))
+        .collect();
+    todo.sort_unstable_by_key(|(p, _, _)| key(*p));
+    todo.dedup_by_key(|(p, _, _)| key(*p));
+    let values: Vec<_> = todo
+        .par_iter()
+        .map(|&(q, a, b)| {
+            let (ra, rb) = (&view.regions[a as usize], &view.regions[b as usize]);
+            if a == b {
+                light(q, &[ra])
+            } else {
+                light(q, &[ra, rb])
+            }
+        })
+        .collect();
+    stats.evaluations += values.len() as u64;
+    for (&(q, _, _), val) in todo.iter().zip(values) {
+        cache.insert(key(q), val);
+    }
+    progress.check()?;
+
+    let fails = |s: &Sample| {
+        let exact = cache[&key(s.at)].0;
+        let err = (s.interp - exact).abs();
+        let allowed = (exact.abs() + floor) * (settings.tolerance * SAFETY);
+        err.cmpgt(allowed).any()
+    };
+    let mut edges = Vec::new();
+    let mut centroids: Vec<DVec2> = Vec::new();
+    let mut failed = vec![false; check.len()];
+    for s in &samples {
+        if let Split::Edge(a, b) = s.split {
+            if fails(s) {
+                failed[s.face as usize] = true;
+                edges.push((a.min(b), a.max(b)));
+            }
+        }
+    }
+    for s in &samples {
+        if let Split::Centroid(c) = s.split {
+            // One interior point per element and pass.
+            if !failed[s.face as usize] && fails(s) {
+                failed[s.face as usize] = true;
+                centroids.push(c);
+            }
+        }
+    }
+    Ok((!edges.is_empty() || !centroids.is_empty()).then_some((edges, centroids)))
 }
 
 /// The mesh with the values known at its vertices.
@@ -401,204 +560,20 @@ fn finish(
 }
 
 struct Sample {
-    tri: u32,
+    /// Index of the face in the checked list.
+    face: u32,
     /// Where the light is evaluated.
     at: DVec2,
     /// The element's linear interpolant there.
     interp: DVec3,
+    /// The component across the edge sampled (the face's own for interior samples).
+    other: u32,
     split: Split,
 }
 
 enum Split {
-    /// Element vertices of the edge.
-    Edge(u32, u32),
+    /// Vertices of the edge.
+    Edge(FixedVertexHandle, FixedVertexHandle),
     /// Where to insert a vertex.
     Centroid(DVec2),
-}
-
-/// Inserts `p` unless rounding put it outside the hull (the receiver).
-fn insert_inside(cdt: &mut Cdt, p: Point2<f64>) {
-    if !matches!(
-        cdt.locate(p),
-        PositionInTriangulation::OutsideOfConvexHull(_)
-    ) {
-        let _ = cdt.insert(p);
-    }
-}
-
-/// Splits the CDT edge `a`→`b` (the failed triangle on its left) at its midpoint. An edge
-/// inside a region takes the midpoint as a new vertex. A constraint (a D1/D0 edge, or the
-/// receiver's boundary, which the frame put inside the triangulation) is split by the
-/// triangulation itself (`split_constraint`).
-fn split_edge(cdt: &mut Cdt, a: FixedVertexHandle, b: FixedVertexHandle) {
-    let (pa, pb) = (cdt.vertex(a).position(), cdt.vertex(b).position());
-    let mid = Point2::new(0.5 * (pa.x + pb.x), 0.5 * (pa.y + pb.y));
-    let Some(e) = cdt.get_edge_from_neighbors(a, b).map(|e| e.fix()) else {
-        // Flipped away by an earlier split of this pass: the region still wants a vertex.
-        insert_inside(cdt, mid);
-        return;
-    };
-    let edge = cdt.directed_edge(e);
-    if edge.as_undirected().is_part_of_convex_hull() {
-        return;
-    }
-    if !edge.is_constraint_edge() {
-        // An edge of a flat triangle (three points of one kinked constraint line, spanned
-        // by the triangulation): its midpoint lies on that line to within rounding, and
-        // would cut slivers that rounding may turn over (tests/mesh_validity.rs).
-        let len = DVec2::new(pb.x - pa.x, pb.y - pa.y).length();
-        let flat = [edge, edge.rev()].iter().any(|side| {
-            side.opposite_position().is_some_and(|c| {
-                let h = orient(
-                    DVec2::new(pa.x, pa.y),
-                    DVec2::new(pb.x, pb.y),
-                    DVec2::new(c.x, c.y),
-                )
-                .abs()
-                    / len.max(f64::MIN_POSITIVE);
-                h < FLAT * len
-            })
-        });
-        if flat {
-            return;
-        }
-        insert_inside(cdt, mid);
-        return;
-    }
-    split_constraint(cdt, e, mid);
-}
-
-/// Splits a constraint edge at `mid` (its midpoint) in the triangulation's own structure.
-/// Inserted as a point, a rounded midpoint lies a hair off the line, and the constraint put
-/// back through it leaves a sliver between the line and the point, or a triangle that
-/// rounding turns over (tests/mesh_validity.rs). spade splits an existing constraint in
-/// place only where a new constraint crosses it, at a point its caller chooses: so a
-/// constraint is drawn from the vertex opposite the edge on one side to the one on the
-/// other, split at `mid`, and then unmarked, and the edge's halves stay one constraint line.
-/// Where that line would leave the two triangles (their quadrilateral is not convex), it is
-/// drawn to a vertex put for the purpose just beyond the midpoint, and removed after.
-fn split_constraint(cdt: &mut Cdt, e: spade::handles::FixedDirectedEdgeHandle, mid: Point2<f64>) {
-    let edge = cdt.directed_edge(e);
-    let (ha, hb) = (edge.from().fix(), edge.to().fix());
-    let p2 = |p: Point2<f64>| DVec2::new(p.x, p.y);
-    let (a, b) = (p2(edge.from().position()), p2(edge.to().position()));
-    let (Some(c), Some(d)) = (
-        edge.opposite_vertex().map(|v| v.fix()),
-        edge.rev().opposite_vertex().map(|v| v.fix()),
-    ) else {
-        return;
-    };
-    let (pc, pd) = (p2(cdt.vertex(c).position()), p2(cdt.vertex(d).position()));
-    let crosses = |from: DVec2, to: DVec2| {
-        let (sa, sb) = (orient(from, to, a), orient(from, to, b));
-        (sa > 0.0 && sb < 0.0) || (sa < 0.0 && sb > 0.0)
-    };
-    if crosses(pc, pd) {
-        draw_and_unmark(cdt, (ha, hb), c, d, mid);
-        return;
-    }
-    // A vertex strictly inside the triangle a, d, b, on the line from c through the
-    // midpoint: the line from c to it crosses the edge and nothing else.
-    let m = p2(mid);
-    let side = orient(a, b, pd).signum();
-    let inside = |q: DVec2| {
-        orient(a, b, q) * side > 0.0
-            && orient(b, pd, q) * side > 0.0
-            && orient(pd, a, q) * side > 0.0
-    };
-    let mut t = 1.0;
-    let mut beyond = None;
-    for _ in 0..40 {
-        let q = m + (m - pc) * t;
-        if inside(q) && crosses(pc, q) {
-            beyond = Some(q);
-            break;
-        }
-        t *= 0.5;
-    }
-    let Some(q) = beyond else {
-        return;
-    };
-    let Ok(temp) = cdt.insert(Point2::new(q.x, q.y)) else {
-        return;
-    };
-    // Inserting legalises edges beyond the constraint only: c still faces the edge.
-    if cdt.get_edge_from_neighbors(ha, hb).is_some() {
-        draw_and_unmark(cdt, (ha, hb), c, temp, mid);
-    }
-    cdt.remove(temp);
-}
-
-/// Draws a constraint from `c` to `d` that splits what it crosses at `mid`, then unmarks
-/// what it drew. Where `mid` is no valid split point, spade connects to a vertex nearby
-/// instead, and the drawn line may then run along a constraint that was there before (a
-/// boundary edge): that one stays marked, or the receiver would lose its boundary.
-fn draw_and_unmark(
-    cdt: &mut Cdt,
-    (a, b): (FixedVertexHandle, FixedVertexHandle),
-    c: FixedVertexHandle,
-    d: FixedVertexHandle,
-    mid: Point2<f64>,
-) {
-    // spade takes `mid` where it lies on the edge or in a triangle beside it; elsewhere (a
-    // vertex there already, or rounding past a thin triangle) it would route the edge
-    // through a vertex nearby instead, moving the constraint: left unsplit then.
-    let Some(edge) = cdt.get_edge_from_neighbors(a, b) else {
-        return;
-    };
-    let (e, left, right) = (
-        edge.fix().as_undirected(),
-        edge.face().fix(),
-        edge.rev().face().fix(),
-    );
-    let valid = match cdt.locate(mid) {
-        PositionInTriangulation::OnEdge(x) => x.as_undirected() == e,
-        PositionInTriangulation::OnFace(f) => {
-            left.as_inner() == Some(f) || right.as_inner() == Some(f)
-        }
-        _ => false,
-    };
-    if !valid {
-        return;
-    }
-    let mut before: Vec<(FixedVertexHandle, FixedVertexHandle)> = Vec::new();
-    for v in [c, d] {
-        for e in cdt.vertex(v).out_edges() {
-            if e.is_constraint_edge() {
-                let (x, y) = (e.from().fix(), e.to().fix());
-                before.push((x.min(y), x.max(y)));
-            }
-        }
-    }
-    let drawn_edges = cdt.add_constraint_and_split(c, d, |_| mid);
-    for drawn in drawn_edges {
-        let e = cdt.directed_edge(drawn);
-        let (x, y) = (e.from().fix(), e.to().fix());
-        if !before.contains(&(x.min(y), x.max(y))) {
-            cdt.remove_constraint_edge(drawn.as_undirected());
-        }
-    }
-}
-
-/// Puts four vertices around the receiver, so that its boundary edges lie inside the
-/// triangulation with a triangle beyond them, and are split as the D1/D0 edges are
-/// (`split_constraint`). Extraction leaves out the triangles between the boundary and the
-/// frame (`extract`). Split from the hull instead, a boundary edge's midpoint becomes a hull
-/// vertex, and removing a helper vertex beyond a straight run of boundary vertices left
-/// flat triangles that stopped its splits.
-fn add_frame(cdt: &mut Cdt) {
-    let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
-    for v in cdt.vertices() {
-        let p = DVec2::new(v.position().x, v.position().y);
-        lo = lo.min(p);
-        hi = hi.max(p);
-    }
-    if !(lo.x < hi.x && lo.y < hi.y) {
-        return;
-    }
-    let pad = (hi - lo).max_element();
-    let (lo, hi) = (lo - DVec2::splat(pad), hi + DVec2::splat(pad));
-    for p in [lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)] {
-        let _ = cdt.insert(Point2::new(p.x, p.y));
-    }
 }
