@@ -202,6 +202,16 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
     let t = Instant::now();
     let budget = AtomicU64::new(0);
     let outlines = direct::outlines(scene);
+    // Round lights (a disc facing each point) kink along curves inside their penumbrae.
+    let polygonal: Vec<bool> = scene
+        .lights
+        .iter()
+        .map(|l| match l.kind {
+            crate::scene::LightKind::Point { radius, .. } => radius == 0.0,
+            crate::scene::LightKind::Sun { half_angle, .. } => half_angle == 0.0,
+            _ => true,
+        })
+        .collect();
     let meshes: Vec<ReceiverMesh> = regions
         .par_iter()
         .zip(&scene.faces)
@@ -230,7 +240,19 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
                     &outlines,
                 )
             };
-            mesh::mesh_receiver(rr, &sizing, settings, &tol, &budget, progress, Some(&light))
+            let lights = mesh::refine::Lights {
+                at: &light,
+                polygonal: polygonal.clone(),
+            };
+            mesh::mesh_receiver(
+                rr,
+                &sizing,
+                settings,
+                &tol,
+                &budget,
+                progress,
+                Some(&lights),
+            )
         })
         .collect::<Result<_, _>>()?;
     for m in &meshes {

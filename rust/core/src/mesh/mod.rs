@@ -80,7 +80,7 @@ pub fn mesh_receiver(
     tol: &Tolerances,
     budget: &AtomicU64,
     progress: &crate::Progress,
-    light: Option<&refine::LightAt>,
+    light: Option<&refine::Lights>,
 ) -> Result<ReceiverMesh, BakeError> {
     let light = light.filter(|_| !settings.uniform);
     let arr = &rr.arrangement;

@@ -94,49 +94,55 @@ impl View<'_> {
             })
     }
 
-    /// Where corner `k` of `f` (of kind `kind`) reads the light, and the components whose
-    /// regions that point lies in or borders.
-    pub fn reading(&self, f: Face, k: usize, kind: Kind) -> (DVec2, Vec<u32>) {
+    /// Where corner `k` of `f` (of kind `kind`) reads the light.
+    pub fn reading(&self, f: Face, k: usize, kind: Kind) -> DVec2 {
         let v = self.vertices(f)[k];
         let p = self.position(v);
         match kind {
+            Kind::Unknown | Kind::Plain => p,
+            Kind::Row => self
+                .sector(v, f)
+                .and_then(|sector| nudge(p, sector.iter().map(|&g| self.triangle(g)), self.tol))
+                .unwrap_or(p),
+            Kind::Corner => nudge(p, std::iter::once(self.triangle(f)), self.tol).unwrap_or(p),
+        }
+    }
+
+    /// The components whose regions the reading point of corner `k` of `f` lies in or
+    /// borders: those of the faces on its side of the vertex.
+    pub fn reading_labels(&self, f: Face, k: usize, kind: Kind) -> Vec<u32> {
+        let v = self.vertices(f)[k];
+        let mut labels: Vec<u32> = Vec::new();
+        let mut add = |g: Face| {
+            let l = self.label(g);
+            if !labels.contains(&l) {
+                labels.push(l);
+            }
+        };
+        match kind {
             Kind::Unknown | Kind::Plain => {
-                let mut labels: Vec<u32> = Vec::new();
                 for e in self.cdt.vertex(v).out_edges() {
                     if let Some(g) = e.face().as_inner() {
-                        let g = g.fix();
-                        let l = self.label(g);
-                        if self.inside(g) && !labels.contains(&l) {
-                            labels.push(l);
+                        if self.inside(g.fix()) {
+                            add(g.fix());
                         }
                     }
                 }
-                (p, labels)
             }
-            Kind::Row => {
-                let s = sides(self.cdt, v, self.shift, &|e| self.is_d0(e), &|f| {
-                    self.inside(f)
-                });
-                let Some(sector) = s
-                    .as_ref()
-                    .and_then(|s| s.sectors.iter().find(|sector| sector.contains(&f)))
-                else {
-                    return (p, vec![self.label(f)]);
-                };
-                let mut labels: Vec<u32> = Vec::new();
-                for &g in sector {
-                    let l = self.label(g);
-                    if !labels.contains(&l) {
-                        labels.push(l);
-                    }
-                }
-                let at = nudge(p, sector.iter().map(|&g| self.triangle(g)), self.tol);
-                (at.unwrap_or(p), labels)
-            }
-            Kind::Corner => {
-                let at = nudge(p, std::iter::once(self.triangle(f)), self.tol);
-                (at.unwrap_or(p), vec![self.label(f)])
-            }
+            Kind::Row => match self.sector(v, f) {
+                Some(sector) => sector.into_iter().for_each(add),
+                None => add(f),
+            },
+            Kind::Corner => add(f),
         }
+        labels
+    }
+
+    /// The faces on `f`'s side of the D0 row through `v`.
+    fn sector(&self, v: FixedVertexHandle, f: Face) -> Option<Vec<Face>> {
+        let s = sides(self.cdt, v, self.shift, &|e| self.is_d0(e), &|g| {
+            self.inside(g)
+        })?;
+        s.sectors.into_iter().find(|sector| sector.contains(&f))
     }
 }

@@ -35,6 +35,14 @@ use crate::BakeError;
 /// the given regions, with its light counts (umbra skipped, lit, penumbra).
 pub type LightAt<'a> = dyn Fn(DVec2, &[&Region]) -> (DVec3, [u64; 3]) + Sync + 'a;
 
+/// What refinement knows of the lights: the exact direct light, and per light whether its
+/// light inside a penumbra kinks only along lines the arrangement already holds (a polygon
+/// light: its VE/EV critical lines) unless several occluders overlap there.
+pub struct Lights<'a> {
+    pub at: &'a LightAt<'a>,
+    pub polygonal: Vec<bool>,
+}
+
 /// The floor of the error bound, as a fraction of the receiver's brightest vertex (per
 /// channel): an element is fine where its error is under tolerance × this much light.
 pub const FLOOR: f64 = 0.01;
@@ -123,7 +131,7 @@ pub(crate) fn refine(
     frame: &Frame,
     settings: &Settings,
     tol: &Tolerances,
-    light: &LightAt,
+    lights: &Lights,
     budget: &AtomicU64,
     progress: &crate::Progress,
 ) -> Result<(ReceiverMesh, RefineStats), BakeError> {
@@ -167,7 +175,7 @@ pub(crate) fn refine(
             &mut cache,
             &mut brightest,
             settings,
-            light,
+            lights,
             &mut stats,
             progress,
         )?;
@@ -192,12 +200,12 @@ pub(crate) fn refine(
             }
             split::split_edge(cdt, a, b, &mut touched);
         }
-        for &c in &centroids {
+        for &(c, near) in &centroids {
             if cdt.num_vertices() - before >= room {
                 break;
             }
             let c = c + shift;
-            split::insert_inside(cdt, Point2::new(c.x, c.y));
+            split::insert_inside(cdt, Point2::new(c.x, c.y), near);
         }
         let added = (cdt.num_vertices() - before) as u64;
         budget.fetch_add(added, Ordering::Relaxed);
@@ -323,7 +331,10 @@ fn label_new_faces(
 
 /// Edges to split (their vertices) and interior points to insert, found on the faces
 /// `check`; `None` when all pass.
-type Splits = (Vec<(FixedVertexHandle, FixedVertexHandle)>, Vec<DVec2>);
+type Splits = (
+    Vec<(FixedVertexHandle, FixedVertexHandle)>,
+    Vec<(DVec2, FixedVertexHandle)>,
+);
 
 /// One pass of checks: the light at the corners of `check` and of their neighbours (for
 /// the screening), then at the samples of the faces in doubt.
@@ -335,11 +346,12 @@ fn check_faces(
     cache: &mut Cache,
     brightest: &mut DVec3,
     settings: &Settings,
-    light: &LightAt,
+    lights: &Lights,
     stats: &mut RefineStats,
     progress: &crate::Progress,
 ) -> Result<Option<Splits>, BakeError> {
     let cdt = view.cdt;
+    let light = lights.at;
     let lower = lower_bound(settings);
     // Faces whose corner values are needed: those checked and their neighbours.
     let mut slot = vec![u32::MAX; cdt.num_all_faces()];
@@ -365,30 +377,35 @@ fn check_faces(
         }
     }
     let kinds = &*kinds;
-    let readings: Vec<[(DVec2, Vec<u32>); 3]> = faces
+    let readings: Vec<[DVec2; 3]> = faces
         .par_iter()
         .map(|&f| {
             let vs = view.vertices(f);
             [0, 1, 2].map(|k| view.reading(f, k, kinds[vs[k].index()]))
         })
         .collect();
-    let mut todo: Vec<(DVec2, &[u32])> = readings
-        .iter()
-        .flatten()
-        .filter(|(p, _)| !cache.contains_key(&key(*p)))
-        .map(|(p, l)| (*p, l.as_slice()))
-        .collect();
-    todo.sort_unstable_by_key(|(p, _)| key(*p));
-    todo.dedup_by_key(|(p, _)| key(*p));
+    let mut todo: Vec<(DVec2, u32, u8)> = Vec::new();
+    for (i, r) in readings.iter().enumerate() {
+        for (k, p) in r.iter().enumerate() {
+            if !cache.contains_key(&key(*p)) {
+                todo.push((*p, i as u32, k as u8));
+            }
+        }
+    }
+    todo.sort_unstable_by_key(|(p, _, _)| key(*p));
+    todo.dedup_by_key(|(p, _, _)| key(*p));
     let values: Vec<_> = todo
         .par_iter()
-        .map(|&(p, labels)| {
+        .map(|&(p, i, k)| {
+            let f = faces[i as usize];
+            let kind = kinds[view.vertices(f)[k as usize].index()];
+            let labels = view.reading_labels(f, k as usize, kind);
             let regs: Vec<&Region> = labels.iter().map(|&l| &view.regions[l as usize]).collect();
             light(p, &regs)
         })
         .collect();
     stats.evaluations += values.len() as u64;
-    for (&(p, _), val) in todo.iter().zip(values) {
+    for (&(p, _, _), val) in todo.iter().zip(values) {
         *brightest = brightest.max(val.0);
         cache.insert(key(p), val);
     }
@@ -396,7 +413,7 @@ fn check_faces(
     let floor = *brightest * FLOOR;
     let vals: Vec<[DVec3; 3]> = readings
         .iter()
-        .map(|r| r.clone().map(|(p, _)| cache[&key(p)].0))
+        .map(|r| r.map(|p| cache[&key(p)].0))
         .collect();
     let tris: Vec<[DVec2; 3]> = faces.iter().map(|&f| view.triangle(f)).collect();
     let grads: Vec<_> = tris
@@ -408,8 +425,11 @@ fn check_faces(
     // Samples: edge midpoints (edges at least twice the lower bound) and centroids
     // (elements whose edges are all splittable), at the mean of the reading points so that
     // a sample beside a D0 row or a corner lies on its element's side. Checked exactly only
-    // where the vertex values leave the element in doubt.
-    let mut samples: Vec<Sample> = Vec::new();
+    // where the vertex values leave the element in doubt, and in stages: an element that
+    // fails at a midpoint is split there, so its interior is not read this pass; one that
+    // fails at its centroid is split there, so the points around it are not read either.
+    let mut edge_samples: Vec<Sample> = Vec::new();
+    let mut inner: Vec<u32> = Vec::new();
     for (i, &f) in check.iter().enumerate() {
         // In umbra of every light the exact light is nothing, and so are the vertices
         // (those on its border lie where the light comes in continuously, from nothing,
@@ -438,7 +458,7 @@ fn check_faces(
             continue;
         }
         let vs = view.vertices(f);
-        let c = readings[i].clone().map(|(q, _)| q);
+        let c = readings[i];
         let edges = cdt.face(f).adjacent_edges();
         let mut splittable = 0;
         for k in 0..3 {
@@ -456,7 +476,7 @@ fn check_faces(
                 .map(|g| g.fix())
                 .filter(|&g| view.inside(g))
                 .map_or(label, |g| view.label(g));
-            samples.push(Sample {
+            edge_samples.push(Sample {
                 face: i as u32,
                 at: 0.5 * (c[k] + c[(k + 1) % 3]),
                 interp: 0.5 * (value[k] + value[(k + 1) % 3]),
@@ -465,23 +485,87 @@ fn check_faces(
             });
         }
         if splittable == 3 {
-            samples.push(Sample {
-                face: i as u32,
-                at: (c[0] + c[1] + c[2]) / 3.0,
-                interp: (value[0] + value[1] + value[2]) / 3.0,
-                other: label,
-                split: Split::Centroid((p[0] + p[1] + p[2]) / 3.0),
-            });
-            // In penumbra the light kinks along critical lines that no constraint
-            // follows, and a kink inside an element errs most beside it, not at the
-            // midpoints: three more points, halfway from the centroid to each corner.
-            if region.relations.contains(&Relation::Penumbra) {
-                let centre = (p[0] + p[1] + p[2]) / 3.0;
-                let centre_eval = (c[0] + c[1] + c[2]) / 3.0;
-                let centre_value = (value[0] + value[1] + value[2]) / 3.0;
+            inner.push(i as u32);
+        }
+    }
+    let read = |samples: &[Sample], cache: &mut Cache, stats: &mut RefineStats| {
+        let mut todo: Vec<(DVec2, u32, u32)> = samples
+            .iter()
+            .filter(|s| !cache.contains_key(&key(s.at)))
+            .map(|s| (s.at, view.label(check[s.face as usize]), s.other))
+            .collect();
+        todo.sort_unstable_by_key(|(p, _, _)| key(*p));
+        todo.dedup_by_key(|(p, _, _)| key(*p));
+        let values: Vec<_> = todo
+            .par_iter()
+            .map(|&(q, a, b)| {
+                let (ra, rb) = (&view.regions[a as usize], &view.regions[b as usize]);
+                if a == b {
+                    light(q, &[ra])
+                } else {
+                    light(q, &[ra, rb])
+                }
+            })
+            .collect();
+        stats.evaluations += values.len() as u64;
+        for (&(q, _, _), val) in todo.iter().zip(values) {
+            cache.insert(key(q), val);
+        }
+    };
+    let fails = |s: &Sample, cache: &Cache| {
+        let exact = cache[&key(s.at)].0;
+        let err = (s.interp - exact).abs();
+        let allowed = (exact.abs() + floor) * (settings.tolerance * SAFETY);
+        err.cmpgt(allowed).any()
+    };
+
+    read(&edge_samples, cache, stats);
+    progress.check()?;
+    let mut edges = Vec::new();
+    let mut failed = vec![false; check.len()];
+    for s in &edge_samples {
+        if let Split::Edge(a, b) = s.split {
+            if fails(s, cache) {
+                failed[s.face as usize] = true;
+                edges.push((a.min(b), a.max(b)));
+            }
+        }
+    }
+    drop(edge_samples);
+
+    // One interior point per element and pass: the centroid, else (where the light may
+    // kink along lines that no constraint follows, `kinks_inside`, and a kink inside an
+    // element errs most beside it, not at the midpoints) the first of three points halfway
+    // from the centroid to each corner that fails.
+    let mut centroids: Vec<(DVec2, FixedVertexHandle)> = Vec::new();
+    for stage in 0..2 {
+        let mut samples: Vec<Sample> = Vec::new();
+        for &i in &inner {
+            if failed[i as usize] {
+                continue;
+            }
+            let f = check[i as usize];
+            let label = view.label(f);
+            if stage == 1 && !kinks_inside(&view.regions[label as usize], &lights.polygonal) {
+                continue;
+            }
+            let (p, value) = (tris[i as usize], vals[i as usize]);
+            let c = readings[i as usize];
+            let centre = (p[0] + p[1] + p[2]) / 3.0;
+            let centre_eval = (c[0] + c[1] + c[2]) / 3.0;
+            let centre_value = (value[0] + value[1] + value[2]) / 3.0;
+            if stage == 0 {
+                samples.push(Sample {
+                    face: i,
+                    at: centre_eval,
+                    interp: centre_value,
+                    other: label,
+                    split: Split::Centroid(centre),
+                });
+            } else {
                 for k in 0..3 {
                     samples.push(Sample {
-                        face: i as u32,
+                        face: i,
                         at: 0.5 * (centre_eval + c[k]),
                         interp: 0.5 * (centre_value + value[k]),
                         other: label,
@@ -490,58 +574,34 @@ fn check_faces(
                 }
             }
         }
-    }
-    let mut todo: Vec<(DVec2, u32, u32)> = samples
-        .iter()
-        .filter(|s| !cache.contains_key(&key(s.at)))
-        .map(|s| (s.at, view.label(check[s.face as usize]), s.other))
-        .collect();
-    todo.sort_unstable_by_key(|(p, _, _)| key(*p));
-    todo.dedup_by_key(|(p, _, _)| key(*p));
-    let values: Vec<_> = todo
-        .par_iter()
-        .map(|&(q, a, b)| {
-            let (ra, rb) = (&view.regions[a as usize], &view.regions[b as usize]);
-            if a == b {
-                light(q, &[ra])
-            } else {
-                light(q, &[ra, rb])
-            }
-        })
-        .collect();
-    stats.evaluations += values.len() as u64;
-    for (&(q, _, _), val) in todo.iter().zip(values) {
-        cache.insert(key(q), val);
-    }
-    progress.check()?;
-
-    let fails = |s: &Sample| {
-        let exact = cache[&key(s.at)].0;
-        let err = (s.interp - exact).abs();
-        let allowed = (exact.abs() + floor) * (settings.tolerance * SAFETY);
-        err.cmpgt(allowed).any()
-    };
-    let mut edges = Vec::new();
-    let mut centroids: Vec<DVec2> = Vec::new();
-    let mut failed = vec![false; check.len()];
-    for s in &samples {
-        if let Split::Edge(a, b) = s.split {
-            if fails(s) {
-                failed[s.face as usize] = true;
-                edges.push((a.min(b), a.max(b)));
-            }
-        }
-    }
-    for s in &samples {
-        if let Split::Centroid(c) = s.split {
-            // One interior point per element and pass.
-            if !failed[s.face as usize] && fails(s) {
-                failed[s.face as usize] = true;
-                centroids.push(c);
+        read(&samples, cache, stats);
+        progress.check()?;
+        for s in &samples {
+            if let Split::Centroid(c) = s.split {
+                if !failed[s.face as usize] && fails(s, cache) {
+                    failed[s.face as usize] = true;
+                    centroids.push((c, view.vertices(check[s.face as usize])[0]));
+                }
             }
         }
     }
     Ok((!edges.is_empty() || !centroids.is_empty()).then_some((edges, centroids)))
+}
+
+/// Whether the light may kink inside `region` along lines that no constraint follows: in
+/// the penumbra of a round light (its outline facing each point is a disc), or of a polygon
+/// light behind more than one occluder (where their outlines seen from the point cross, EEE
+/// events, which the arrangement does not hold). Behind one occluder, a polygon light's
+/// kinks are its VE/EV critical lines, which are constraints (`shadows::critical_lines`).
+fn kinks_inside(region: &Region, polygonal: &[bool]) -> bool {
+    region
+        .relations
+        .iter()
+        .zip(&region.blockers)
+        .enumerate()
+        .any(|(l, (r, b))| {
+            *r == Relation::Penumbra && (b.len() > 1 || !polygonal.get(l).copied().unwrap_or(false))
+        })
 }
 
 /// The mesh with the values known at its vertices.

@@ -12,12 +12,14 @@ use super::Cdt;
 use crate::geom::polygon::orient;
 
 /// Inserts `p` unless rounding put it outside the hull (the receiver).
-pub(super) fn insert_inside(cdt: &mut Cdt, p: Point2<f64>) {
+/// `near` is a vertex close by, where spade starts looking (from the last vertex put in, the
+/// walk crossed a receiver; a sixth of cornell's refinement).
+pub(super) fn insert_inside(cdt: &mut Cdt, p: Point2<f64>, near: FixedVertexHandle) {
     if !matches!(
-        cdt.locate(p),
+        cdt.locate_with_hint(p, near),
         PositionInTriangulation::OutsideOfConvexHull(_)
     ) {
-        let _ = cdt.insert(p);
+        let _ = cdt.insert_with_hint(p, near);
     }
 }
 
@@ -37,7 +39,7 @@ pub(super) fn split_edge(
     let mid = Point2::new(0.5 * (pa.x + pb.x), 0.5 * (pa.y + pb.y));
     let Some(e) = cdt.get_edge_from_neighbors(a, b).map(|e| e.fix()) else {
         // Flipped away by an earlier split of this pass: the region still wants a vertex.
-        insert_inside(cdt, mid);
+        insert_inside(cdt, mid, a);
         return;
     };
     let edge = cdt.directed_edge(e);
@@ -64,7 +66,7 @@ pub(super) fn split_edge(
         if flat {
             return;
         }
-        insert_inside(cdt, mid);
+        insert_inside(cdt, mid, a);
         return;
     }
     split_constraint(cdt, e, mid, touched);
@@ -126,7 +128,7 @@ fn split_constraint(
     let Some(q) = beyond else {
         return;
     };
-    let Ok(temp) = cdt.insert(Point2::new(q.x, q.y)) else {
+    let Ok(temp) = cdt.insert_with_hint(Point2::new(q.x, q.y), c) else {
         return;
     };
     // Inserting legalises edges beyond the constraint only: c still faces the edge.
@@ -168,7 +170,7 @@ fn draw_and_unmark(
         edge.face().fix(),
         edge.rev().face().fix(),
     );
-    let valid = match cdt.locate(mid) {
+    let valid = match cdt.locate_with_hint(mid, a) {
         PositionInTriangulation::OnEdge(x) => x.as_undirected() == e,
         PositionInTriangulation::OnFace(f) => {
             left.as_inner() == Some(f) || right.as_inner() == Some(f)
