@@ -454,7 +454,12 @@ fn check_faces(
             })
             .collect();
         let p = tris[i];
-        if !doubt::doubtful(p, value, &neighbours, allowed) {
+        let screen = if region.relations.contains(&Relation::Penumbra) {
+            doubt::SCREEN
+        } else {
+            doubt::SCREEN_SMOOTH
+        };
+        if !doubt::doubtful(p, value, &neighbours, allowed, screen) {
             continue;
         }
         let vs = view.vertices(f);
