@@ -246,7 +246,7 @@ pub(crate) fn refine(
             }
         }
     }
-    debug_assert!(cdt.inner_faces().all(|f| f.data().0 != u32::MAX));
+    debug_assert!(labels_agree(cdt, &regions));
     let comp: Vec<u32> = cdt.inner_faces().map(|f| f.data().0).collect();
     let mut m = extract_with(
         cdt,
@@ -264,9 +264,30 @@ pub(crate) fn refine(
     Ok(finish(m, &cache, stats))
 }
 
-/// Gives the faces around `touched` that spade made (still unlabelled) the component of a
-/// labelled neighbour across an edge that is not a constraint (insertions and flips stay in
-/// one component); returns every face around `touched`.
+/// Whether every edge that is not a constraint joins faces whose labels stand for the same
+/// region, as the components they were classified from do.
+fn labels_agree(cdt: &Cdt, regions: &[Region]) -> bool {
+    cdt.inner_faces().all(|f| {
+        let l = f.data().0;
+        l != u32::MAX
+            && f.adjacent_edges().iter().all(|e| {
+                let Some(g) = e.rev().face().as_inner() else {
+                    return true;
+                };
+                let m = g.data().0;
+                e.is_constraint_edge()
+                    || (m != u32::MAX
+                        && regions[l as usize].relations == regions[m as usize].relations
+                        && regions[l as usize].blockers == regions[m as usize].blockers)
+            })
+    })
+}
+
+/// Labels the faces around `touched` (all that spade changed) anew, each with the label of a
+/// neighbour across an edge that is not a constraint, starting from the faces spade left
+/// alone: spade gives a face it makes no data and may hand a face it reuses to a triangle on
+/// the other side of a constraint (hard_cases' fifty occluders: 64 edges inside a component
+/// between two labels). Returns every face around `touched`.
 fn label_new_faces(
     cdt: &mut Cdt,
     touched: &[FixedVertexHandle],
@@ -285,11 +306,10 @@ fn label_new_faces(
     }
     around.sort_unstable();
     around.dedup();
-    let mut fresh: Vec<Face> = around
-        .iter()
-        .copied()
-        .filter(|&f| cdt.face(f).data().0 == u32::MAX)
-        .collect();
+    for &f in &around {
+        *cdt.face_data_mut(f) = Label::default();
+    }
+    let mut fresh = around.clone();
     while !fresh.is_empty() {
         let mut next = Vec::new();
         for &f in &fresh {
@@ -306,23 +326,42 @@ fn label_new_faces(
             }
         }
         if next.len() == fresh.len() {
-            // No labelled neighbour (not seen from spade's operations): classified on its own.
-            for &f in &next {
-                let face = cdt.face(f);
-                let c = face.center();
-                let out = face
+            // A component whose faces all changed: one face is labelled afresh and the
+            // others follow it. Faces that reach the hull lie outside the receiver (its
+            // boundary is a constraint), so those go first; else the largest face, whose
+            // centre lies clear of the region's lines, is classified.
+            let touches_hull = |f: Face| {
+                cdt.face(f)
                     .adjacent_edges()
                     .iter()
-                    .any(|e| !e.is_constraint_edge() && e.rev().face().is_outer());
-                regions.push(if out {
-                    Region::default()
-                } else {
-                    rr.classify(DVec2::new(c.x, c.y) - shift)
-                });
-                outside.push(out);
-                *cdt.face_data_mut(f) = Label(regions.len() as u32 - 1);
-            }
-            break;
+                    .any(|e| !e.is_constraint_edge() && e.rev().face().is_outer())
+            };
+            let seed = match next.iter().copied().find(|&f| touches_hull(f)) {
+                Some(f) => {
+                    let l = match outside.iter().position(|&o| o) {
+                        Some(l) => l,
+                        None => {
+                            regions.push(Region::default());
+                            outside.push(true);
+                            regions.len() - 1
+                        }
+                    };
+                    (f, l)
+                }
+                None => {
+                    let f = next
+                        .iter()
+                        .copied()
+                        .max_by(|a, b| cdt.face(*a).area().total_cmp(&cdt.face(*b).area()))
+                        .expect("not empty");
+                    let c = cdt.face(f).center();
+                    regions.push(rr.classify(DVec2::new(c.x, c.y) - shift));
+                    outside.push(false);
+                    (f, regions.len() - 1)
+                }
+            };
+            *cdt.face_data_mut(seed.0) = Label(seed.1 as u32);
+            next.retain(|&f| f != seed.0);
         }
         fresh = next;
     }
