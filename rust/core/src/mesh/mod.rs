@@ -5,6 +5,7 @@
 //! contact shadows, point-light shadows) get two vertex rows, one per side.
 
 pub mod cancel;
+mod check;
 mod corner_split;
 mod doubt;
 pub mod elements;
