@@ -120,6 +120,15 @@ def test_exported_scene_is_valid_for_the_core(room_scene, empty):
     assert export_scene(empty, empty.scene.penumbra).scene["settings"]["element_size"] < draft
 
 
+def test_quality_presets_set_the_tolerance(room_scene, empty):
+    # Draft 3 %, Medium 1 %, High 0.3 % relative error of the baked direct light (issue 13).
+    got = {}
+    for q in ("DRAFT", "MEDIUM", "HIGH"):
+        empty.scene.penumbra.quality = q
+        got[q] = export_scene(empty, empty.scene.penumbra).scene["settings"]["tolerance"]
+    assert got == {"DRAFT": 0.03, "MEDIUM": 0.01, "HIGH": 0.003}
+
+
 # --- import --------------------------------------------------------------------------------
 
 

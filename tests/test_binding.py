@@ -121,6 +121,24 @@ def test_nothing_to_bake():
     assert error_of(scene).kind == "empty"
 
 
+def test_tolerance_setting_refines_and_is_checked():
+    # A tighter tolerance gives more elements, each refinement pass counted (issue 13). At
+    # 3 % the starting lattice already meets it on this smooth field (no pass splits).
+    counts, passes = [], []
+    for tol in (0.03, 0.001):
+        scene = plane_under_square_light()
+        scene["settings"]["tolerance"] = tol
+        stats = _core.bake(scene)["stats"]
+        counts.append(stats["N_e"])
+        passes.append(stats["refine_passes"])
+    assert passes[1] >= 1 and passes[1] >= passes[0]
+    assert counts[1] > counts[0]
+    scene = plane_under_square_light()
+    scene["settings"]["tolerance"] = 0.0
+    e = error_of(scene)
+    assert (e.kind, e.field) == ("setting", "tolerance")
+
+
 def test_errors_arrive_through_the_job_too():
     scene = plane_under_square_light()
     scene["settings"]["element_size"] = -1.0

@@ -351,6 +351,9 @@ def main():
                     help="only Cycles on a uniform mesh (a vertex-colour user's bake) against "
                     "Penumbra and Cycles at the probes; writes OUT/cycles_uniform.json and its "
                     "section of OUT/results.md and README.md")
+    ap.add_argument("--tolerance", action="store_true",
+                    help="only direct light refined to tolerances 3 %%…0.1 %% against uniform "
+                    "meshes, and room-8328 direct-only (bench_lib/tolerance.py)")
     ap.add_argument("--solvers-only", action="store_true",
                     help="only the two indirect solvers on full bakes (default scenes plus "
                     "room-245; --quick: the first four); writes OUT/solvers.json and its section "
@@ -374,6 +377,16 @@ def main():
     a.scenes = a.scenes or cfg.scenes
     os.makedirs(a.work, exist_ok=True)
     os.makedirs(a.out, exist_ok=True)
+    if a.tolerance:
+        from bench_lib import tolerance
+
+        md = tolerance.run(a, cfg, machine(), lambda args, what: cycles(sys.executable, args, what),
+                           log, matched_uniform, ROOT)
+        if os.path.abspath(a.out) == os.path.join(ROOT, "bench"):
+            tolerance.splice(os.path.join(ROOT, "README.md"),
+                             md.replace("(error_vs_elements.png)", "(bench/error_vs_elements.png)"))
+        print(md)
+        return
     t0 = time.perf_counter()
     command = "scripts/bench" + (" --quick" if a.quick else "")
     if a.lightmap_only:

@@ -32,11 +32,11 @@ class PenumbraSettings(bpy.types.PropertyGroup):
     )
     quality: EnumProperty(
         name="Quality",
-        description="Element size relative to the size of the baked scene",
+        description="Error of the baked direct light the elements are refined to",
         items=(
-            ("DRAFT", "Draft", "Coarse elements: a quick look"),
-            ("MEDIUM", "Medium", "Balanced"),
-            ("HIGH", "High", "Fine elements, sharp penumbrae; slower"),
+            ("DRAFT", "Draft", "Direct light within 3 %: a quick look"),
+            ("MEDIUM", "Medium", "Direct light within 1 %"),
+            ("HIGH", "High", "Direct light within 0.3 %, sharp penumbrae; slower"),
         ),
         default="MEDIUM",
     )

@@ -266,3 +266,42 @@ fn argument_errors_are_one_line_and_exit_2() {
     assert_eq!(out.status.code(), Some(0));
     assert!(String::from_utf8_lossy(&out.stdout).contains("bake"));
 }
+
+#[test]
+fn tolerance_flag_checked_like_the_setting() {
+    let p = write("tolerance.json", GOOD);
+    for t in ["0", "2", "NaN"] {
+        let out = penumbra()
+            .args([
+                "bake",
+                p.to_str().unwrap(),
+                "-o",
+                "/dev/null",
+                "--tolerance",
+                t,
+            ])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "--tolerance {t}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "--tolerance {t}: {err}");
+        assert!(err.contains("tolerance"), "--tolerance {t}: {err}");
+    }
+    let out = penumbra()
+        .args([
+            "bake",
+            p.to_str().unwrap(),
+            "-o",
+            "/dev/null",
+            "--tolerance",
+            "0.03",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

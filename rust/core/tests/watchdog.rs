@@ -1,5 +1,6 @@
-//! The memory watchdog: what the estimate before baking cannot foresee (here a penumbra
-//! element size far below the coarse size the estimate counts) still ends as one clean
+//! The memory watchdog: what the estimate before baking cannot foresee (here refinement to
+//! a tolerance of 1e-5, down to a penumbra element size far below the coarse size the
+//! estimate counts) still ends as one clean
 //! `max_memory` error once the bake has grown past the budget, not as a machine that swaps.
 //! Its own test binary: the watchdog looks at the whole process's memory.
 
@@ -12,7 +13,7 @@ fn a_bake_growing_past_max_memory_stops_with_a_setting_error() {
                {"name":"Box","positions":[[-0.4,-0.4,1],[0.4,-0.4,1],[0.4,0.4,1],[-0.4,0.4,1]],"polygons":[[0,1,2,3]]}],
      "lights":[{"name":"Area","polygon":[[-0.5,-0.5,2],[-0.5,0.5,2],[0.5,0.5,2],[0.5,-0.5,2]],"radiance":[1,1,1]}],
      "settings":{"indirect":false,"element_size":0.5,"penumbra_element_size":0.002,
-                 "max_memory":16777216}}"#;
+                 "tolerance":1e-5,"max_memory":16777216}}"#;
     let json = penumbra::SceneJson::from_str(text).unwrap();
     // The estimate (coarse elements only) fits in 16 MiB...
     let scene = penumbra::scene::validate(&json).unwrap();

@@ -101,8 +101,14 @@ fn a_many_edged_occluder_changes_the_light_by_less_than_its_simplification_band(
         worst < 5e-3,
         "worst error {worst:e} of the unoccluded light"
     );
-    // The mesh follows ~50 outline edges, not 400: a few thousand vertices.
-    assert!(floor.positions.len() < 8_000, "{}", floor.positions.len());
+    // The mesh follows ~50 outline edges, not 400: some thousand vertices. Refinement to the
+    // default 1 % tolerance (issue 13) puts 12,353 there, against 7,886 unrefined, all but a
+    // tenth of the triangles in the penumbra: at a random point of every element above the
+    // lower size bound, measured as tests/tolerance.rs measures (exact light of the 400-gon),
+    // unrefined errs up to 44 × tolerance × (exact + 1 % floor), rms 4.1e-2; refined 5.0 ×,
+    // rms 3.7e-3, the rest being the simplification band above (the disk as a 48-gon,
+    // not simplified: 10,450 vertices, 0.38 × refined, 42 × unrefined).
+    assert!(floor.positions.len() < 13_000, "{}", floor.positions.len());
 }
 
 /// 400 small quads over a floor (quads2000 scaled down). Delaunay refinement used to run
@@ -255,8 +261,13 @@ fn the_floor_under_many_shadows_follows_the_exact_light() {
         worst < 4e-2,
         "worst error {worst:e} of the unoccluded light"
     );
+    // Refinement to the default 1 % tolerance (issue 13) puts 83,064 vertices here against
+    // 65,611 unrefined (the Delaunay mesh alone, as before refinement), nearly all of them in
+    // the penumbra, which covers the floor: at a random point of every element above the
+    // lower size bound (tests/tolerance.rs's measure), unrefined errs up to 22 × tolerance ×
+    // (exact + 1 % floor), refined to 3 % (68,109) 1.4 ×, refined to 1 % 0.41 ×.
     assert!(
-        floor.positions.len() < 80_000,
+        floor.positions.len() < 88_000,
         "{} floor vertices",
         floor.positions.len()
     );

@@ -16,6 +16,7 @@ use crate::geom::polygon::convex_hull_2d;
 use crate::geom::{Frame, Plane};
 use crate::mesh::elements::Elements;
 use crate::regions::relation::Relation;
+use crate::regions::Region;
 use crate::scene::solids::{Occluder, Solid};
 use crate::scene::{LightKind, Scene, Tolerances};
 
@@ -34,12 +35,7 @@ pub fn direct_irradiance(
         .iter()
         .map(|&(t, _)| el.tri_region[t as usize])
         .collect();
-    // Many-edged faces' outlines for the area-light booleans (see geom::simplify).
-    let simple: Vec<Option<Vec<DVec3>>> = scene
-        .faces
-        .par_iter()
-        .map(|f| crate::geom::simplify::simplified(&f.verts))
-        .collect();
+    let simple = outlines(scene);
     progress.check()?;
     let done = std::sync::atomic::AtomicUsize::new(0);
     let results: Vec<(DVec3, [u64; 3])> = (0..nv)
@@ -54,6 +50,10 @@ pub fn direct_irradiance(
             }
             if progress.is_cancelled() {
                 return (DVec3::ZERO, [0; 3]);
+            }
+            // Computed while refining the mesh (`mesh::refine`): not again.
+            if let Some(known) = el.known_direct.get(v).copied().flatten() {
+                return known;
             }
             let mut regions: Vec<u32> = around[count[v] as usize..count[v + 1] as usize].to_vec();
             regions.sort_unstable();
@@ -75,15 +75,14 @@ pub fn direct_irradiance(
     Ok((e, counts))
 }
 
-/// Where to evaluate an area light for vertex `v` at `p`: `p` itself, unless `p` lies in the
+/// Where to evaluate an area light at `p` on receiver `face`: `p` itself, unless `p` lies in the
 /// light's plane. That happens where a receiver meets an emissive face (`scene::emitters`):
 /// a floor vertex on the foot of a glowing wall sees the wall edge-on, so no light at all,
 /// where the floor a hair away gets plenty. A point a hair into the vertex's own face gives
 /// the limit that the elements around it show.
 fn on_light_plane(
     scene: &Scene,
-    el: &Elements,
-    v: usize,
+    face: u32,
     p: DVec3,
     plane: &crate::geom::Plane,
     tol: &Tolerances,
@@ -91,7 +90,7 @@ fn on_light_plane(
     if plane.dist(p).abs() > tol.flat {
         return p;
     }
-    let f = &scene.faces[el.vertex_face[v] as usize];
+    let f = &scene.faces[face as usize];
     let centre = f.verts.iter().copied().sum::<DVec3>() / f.verts.len().max(1) as f64;
     let d = centre - p;
     let l = d.length();
@@ -109,15 +108,45 @@ fn vertex_direct(
     regions: &[u32],
     simple: &[Option<Vec<DVec3>>],
 ) -> (DVec3, [u64; 3]) {
-    let p = el.eval[v];
-    let n = el.normals[v];
+    let regions: Vec<&Region> = regions.iter().map(|&r| &el.regions[r as usize]).collect();
+    light_at(
+        scene,
+        tol,
+        el.vertex_face[v],
+        el.eval[v],
+        el.normals[v],
+        &regions,
+        simple,
+    )
+}
+
+/// Many-edged faces' outlines for the area-light booleans (see geom::simplify), per face.
+pub(crate) fn outlines(scene: &Scene) -> Vec<Option<Vec<DVec3>>> {
+    scene
+        .faces
+        .par_iter()
+        .map(|f| crate::geom::simplify::simplified(&f.verts))
+        .collect()
+}
+
+/// Direct irradiance at `p` (normal `n`) of receiver `face`, lying in or on the border of
+/// `regions`, and the light counts (umbra skipped, lit, penumbra); `simple` from `outlines`.
+/// Shared by the direct stage (at vertices) and by refinement to a tolerance
+/// (`mesh::refine`, at any point), so that both compute one light.
+pub(crate) fn light_at(
+    scene: &Scene,
+    tol: &Tolerances,
+    face: u32,
+    p: DVec3,
+    n: DVec3,
+    regions: &[&Region],
+    simple: &[Option<Vec<DVec3>>],
+) -> (DVec3, [u64; 3]) {
     let mut e = DVec3::ZERO;
     let mut counts = [0u64; 3];
     let mut occ: Vec<u32> = Vec::new();
     for (li, light) in scene.lights.iter().enumerate() {
-        let rels = regions
-            .iter()
-            .map(|&r| el.regions[r as usize].relations[li]);
+        let rels = regions.iter().map(|r| r.relations[li]);
         let all = |want: Relation| rels.clone().all(|r| r == want);
         let relation = if regions.is_empty() || all(Relation::Umbra) {
             Relation::Umbra
@@ -136,8 +165,8 @@ fn vertex_direct(
         }
         occ.clear();
         if relation == Relation::Penumbra {
-            for &r in regions {
-                occ.extend_from_slice(&el.regions[r as usize].blockers[li]);
+            for r in regions {
+                occ.extend_from_slice(&r.blockers[li]);
             }
             occ.sort_unstable();
             occ.dedup();
@@ -194,7 +223,7 @@ fn vertex_direct(
             .chain(owned.iter().map(|v| v.as_slice()))
             .collect();
         let area_at = match &light.kind {
-            LightKind::Area { plane, .. } => on_light_plane(scene, el, v, p, plane, tol),
+            LightKind::Area { plane, .. } => on_light_plane(scene, face, p, plane, tol),
             _ => p,
         };
         e += light_irradiance(

@@ -16,12 +16,12 @@
 use std::sync::mpsc;
 use std::time::Duration;
 
-use spade::{ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation};
+use spade::{RefinementParameters, Triangulation};
 
 use crate::progress::Progress;
 use crate::BakeError;
 
-type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
+use super::Cdt;
 
 /// Refinements allowed at most this many vertices run inline: some 50 ms in a release
 /// build, so a thread is not worth it.
@@ -71,6 +71,7 @@ pub fn refine_in_rounds(
 #[cfg(test)]
 mod test {
     use super::*;
+    use spade::Point2;
 
     /// Random points and crossing constraints in the unit square, seeded.
     fn triangulation() -> Cdt {

@@ -22,6 +22,9 @@ pub struct Elements {
     /// Region (index into `regions`) of each triangle.
     pub tri_region: Vec<u32>,
     pub regions: Vec<Region>,
+    /// Direct irradiance already computed at a vertex (by `mesh::refine`) with its light
+    /// counts (umbra, lit, penumbra), or `None`; empty when nothing was.
+    pub known_direct: Vec<Option<(DVec3, [u64; 3])>>,
 }
 
 impl Elements {

@@ -5,28 +5,35 @@
 //! contact shadows, point-light shadows) get two vertex rows, one per side.
 
 pub mod cancel;
+mod check;
+mod corner_split;
+mod doubt;
 pub mod elements;
+mod extract;
+mod lattice;
+mod readings;
+pub mod refine;
+mod sides;
 pub mod sizing;
+mod split;
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::{DVec2, DVec3};
-use rayon::prelude::*;
 
-use crate::geom::Frame;
 use spade::handles::FixedVertexHandle;
 use spade::{
     AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation,
 };
 
-use crate::geom::polygon::{orient, segment_distance as seg_dist};
 use crate::mesh::sizing::Sizing;
-use crate::regions::arrangement::ArrFace;
 use crate::regions::relation::Relation;
 use crate::regions::{ReceiverRegions, Region};
 use crate::scene::settings::Settings;
 use crate::scene::Tolerances;
 use crate::BakeError;
+use extract::extract;
+use lattice::{graded_lattice, Corners};
 
 /// The element mesh of one receiver, in its 2-D frame.
 #[derive(Debug, Clone, Default)]
@@ -38,14 +45,35 @@ pub struct ReceiverMesh {
     pub triangles: Vec<[u32; 3]>,
     pub tri_region: Vec<u32>,
     pub regions: Vec<Region>,
+    /// Direct light per vertex when refinement computed it (else empty).
+    pub known_direct: Vec<Option<(DVec3, [u64; 3])>>,
+    /// Vertices where D0 edges end or turn (a box's foot corner): `corner_split` gives
+    /// each triangle there its own copy.
+    pub d0_corners: Vec<DVec2>,
+    pub refine: refine::RefineStats,
 }
 
-type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
+/// Which component of the triangulation (faces joined across edges that are not
+/// constraints) a face belongs to, while refinement runs; `u32::MAX` on faces spade has just
+/// made, until refinement labels them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Label(pub u32);
+
+impl Default for Label {
+    fn default() -> Self {
+        Label(u32::MAX)
+    }
+}
+
+pub(crate) type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>, (), (), Label>;
 
 /// Meshes one receiver. `budget` counts vertices over the whole scene so that a bake that
 /// would exceed `max_elements` stops early with a clear error. Evaluation points on D0 rows
 /// move at least `tol.d0_offset` off the line, so that the exact side tests of the light
-/// stages see them on their own side.
+/// stages see them on their own side. With `light`, elements are then refined until the
+/// direct light meets `settings.tolerance` (`refine`); the lattice is then seeded at the lit
+/// size everywhere, penumbrae included, and refinement finds where it must be finer.
+#[allow(clippy::too_many_arguments)]
 pub fn mesh_receiver(
     rr: &ReceiverRegions,
     sizing: &Sizing,
@@ -53,7 +81,9 @@ pub fn mesh_receiver(
     tol: &Tolerances,
     budget: &AtomicU64,
     progress: &crate::Progress,
+    light: Option<&refine::Lights>,
 ) -> Result<ReceiverMesh, BakeError> {
+    let light = light.filter(|_| !settings.uniform);
     let arr = &rr.arrangement;
     let shift = shift_away_from_zero(&arr.vertices);
     let mut cdt = Cdt::new();
@@ -89,7 +119,9 @@ pub fn mesh_receiver(
     let mut seeds = Vec::new();
     for (f, rf) in arr.faces.iter().zip(&rr.faces) {
         progress.check()?;
-        let penumbra = !settings.uniform && rf.relations.iter().any(|r| *r == Relation::Penumbra);
+        let penumbra = !settings.uniform
+            && light.is_none()
+            && rf.relations.iter().any(|r| *r == Relation::Penumbra);
         let seen = |l: usize| rf.relations.get(l).is_some_and(|r| *r != Relation::Umbra);
         let size = |p: DVec2, reach: f64| {
             let s = if penumbra {
@@ -97,7 +129,13 @@ pub fn mesh_receiver(
             } else {
                 sizing.lit(p, reach, &seen)
             };
-            corners.cap(s, p, reach)
+            // Refinement finds what the corners need (and `corner_split` gives each
+            // triangle there its own value): no grading towards them beforehand.
+            if light.is_some() {
+                s
+            } else {
+                corners.cap(s, p, reach)
+            }
         };
         graded_lattice(&arr.vertices, f, &size, &mut seeds);
     }
@@ -129,15 +167,11 @@ pub fn mesh_receiver(
     let fine_area = 0.433 * fine * fine;
     let extra =
         (settings.max_elements.saturating_sub(used) as usize).min(cdt.num_vertices() * 4 + 64);
-    cancel::refine_in_rounds(
-        &mut cdt,
-        RefinementParameters::new()
-            .with_angle_limit(AngleLimit::from_deg(settings.min_angle))
-            .with_max_allowed_area(coarse_area * 1.5)
-            .with_min_required_area(fine_area * if dense { DENSE_MIN_AREA } else { 0.02 }),
-        extra,
-        progress,
-    )?;
+    let angles = RefinementParameters::new()
+        .with_angle_limit(AngleLimit::from_deg(settings.min_angle))
+        .with_max_allowed_area(coarse_area * 1.5)
+        .with_min_required_area(fine_area * if dense { DENSE_MIN_AREA } else { 0.02 });
+    cancel::refine_in_rounds(&mut cdt, angles.clone(), extra, progress)?;
     budget.fetch_add(
         cdt.num_vertices() as u64 - inserted as u64,
         Ordering::Relaxed,
@@ -151,6 +185,21 @@ pub fn mesh_receiver(
         return Ok(m);
     }
     progress.check()?;
+    if let Some(light) = light {
+        let (mut m, stats) = refine::refine(
+            &mut cdt,
+            rr,
+            shift,
+            sizing.frame(),
+            settings,
+            tol,
+            light,
+            budget,
+            progress,
+        )?;
+        m.refine = stats;
+        return Ok(m);
+    }
     Ok(extract(&cdt, shift, rr, sizing.frame(), false, tol))
 }
 
@@ -203,438 +252,4 @@ fn shift_away_from_zero(verts: &[DVec2]) -> DVec2 {
         1.0
     };
     DVec2::new(span - lo.x, span - lo.y)
-}
-
-/// Ends of D0 lines (the feet of a box on the floor, where a solid passes through): there
-/// the light depends on the direction one comes from, not on the distance, so no linear
-/// element that touches such a point is right, however small. Elements shrink towards them
-/// in proportion to the distance, which keeps each element's angular span, and with it the
-/// interpolation error, bounded, and leaves the wrong values at the corner itself only a
-/// tiny area.
-struct Corners {
-    points: Vec<DVec2>,
-    floor: f64,
-}
-
-/// Element size at most this fraction of the distance to a corner.
-const PER_CORNER_DISTANCE: f64 = 0.7;
-/// ... and never below this fraction of `element_size`.
-const CORNER_FLOOR: f64 = 1.0 / 16.0;
-
-impl Corners {
-    fn new(d0_lines: &[[DVec2; 2]], coarse: f64) -> Self {
-        let mut points: Vec<DVec2> = d0_lines.iter().flat_map(|[a, b]| [*a, *b]).collect();
-        points.sort_unstable_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
-        points.dedup();
-        Corners {
-            points,
-            floor: coarse * CORNER_FLOOR,
-        }
-    }
-
-    /// `size` capped near corners, for anywhere within `reach` of `p` (a negative reach: the
-    /// largest cap there).
-    fn cap(&self, size: f64, p: DVec2, reach: f64) -> f64 {
-        let near = self
-            .points
-            .iter()
-            .map(|c| (*c - p).length())
-            .fold(f64::INFINITY, f64::min);
-        if !near.is_finite() {
-            return size;
-        }
-        size.min(((near - reach).max(0.0) * PER_CORNER_DISTANCE).max(self.floor))
-    }
-
-    fn smallest(&self) -> f64 {
-        if self.points.is_empty() {
-            f64::INFINITY
-        } else {
-            self.floor
-        }
-    }
-}
-
-/// Lattice points in `f` whose spacing follows `size(p, reach)` (the size anywhere within
-/// `reach` of `p`; a negative reach asks for the largest size there): the face's bounds are
-/// split into blocks until the size varies little across each, then each block gets a
-/// lattice at its smallest size. Blocks of one size share one global lattice, so they
-/// join seamlessly; where sizes step, refinement mends the angles.
-fn graded_lattice(
-    verts: &[DVec2],
-    f: &ArrFace,
-    size: &dyn Fn(DVec2, f64) -> f64,
-    out: &mut Vec<DVec2>,
-) {
-    let mut lo = DVec2::splat(f64::INFINITY);
-    let mut hi = DVec2::splat(f64::NEG_INFINITY);
-    for &v in &f.outer {
-        lo = lo.min(verts[v as usize]);
-        hi = hi.max(verts[v as usize]);
-    }
-    if !(lo.x <= hi.x && lo.y <= hi.y) {
-        return;
-    }
-    let mut stack = vec![(lo, hi, 0u32)];
-    while let Some((blo, bhi, depth)) = stack.pop() {
-        let c = 0.5 * (blo + bhi);
-        let reach = 0.5 * (bhi - blo).length();
-        let small = size(c, reach);
-        let large = size(c, -reach);
-        let side = (bhi - blo).max_element();
-        if large <= 1.5 * small || side <= 4.0 * small || depth >= 12 {
-            lattice_in_face(verts, f, small, (blo, bhi), (lo, hi), out);
-            continue;
-        }
-        let m = c;
-        for (a, b) in [
-            (blo, m),
-            (DVec2::new(m.x, blo.y), DVec2::new(bhi.x, m.y)),
-            (DVec2::new(blo.x, m.y), DVec2::new(m.x, bhi.y)),
-            (m, bhi),
-        ] {
-            stack.push((a, b, depth + 1));
-        }
-    }
-}
-
-/// Triangular lattice points strictly inside `f` and in the block `[blo, bhi)` (closed on
-/// the sides where the block meets the face's bounds `outer`), at least 0.35·h from the
-/// face's boundary.
-fn lattice_in_face(
-    verts: &[DVec2],
-    f: &ArrFace,
-    h: f64,
-    (blo, bhi): (DVec2, DVec2),
-    outer: (DVec2, DVec2),
-    out: &mut Vec<DVec2>,
-) {
-    if f.area < 0.2 * h * h {
-        return;
-    }
-    let (lo, hi) = (blo, bhi);
-    let in_block = |p: DVec2| {
-        p.x >= blo.x
-            && p.y >= blo.y
-            && (p.x < bhi.x || bhi.x >= outer.1.x)
-            && (p.y < bhi.y || bhi.y >= outer.1.y)
-    };
-    let dy = h * 0.866_025_403_784_438_6;
-    let j0 = (lo.y / dy).floor() as i64;
-    let j1 = (hi.y / dy).ceil() as i64;
-    let i0 = (lo.x / h).floor() as i64 - 1;
-    let i1 = (hi.x / h).ceil() as i64 + 1;
-    let loops: Vec<&Vec<u32>> = std::iter::once(&f.outer).chain(f.holes.iter()).collect();
-    let clearance = 0.35 * h;
-    for j in j0..=j1 {
-        let y = j as f64 * dy;
-        let off = if j.rem_euclid(2) == 1 { 0.5 * h } else { 0.0 };
-        for i in i0..=i1 {
-            let p = DVec2::new(i as f64 * h + off, y);
-            if p.x < lo.x || p.x > hi.x || p.y < lo.y || p.y > hi.y || !in_block(p) {
-                continue;
-            }
-            if winding(verts, &f.outer, p) == 0
-                || f.holes.iter().any(|hl| winding(verts, hl, p) != 0)
-            {
-                continue;
-            }
-            let near = loops.iter().any(|l| {
-                (0..l.len()).any(|k| {
-                    seg_dist(
-                        verts[l[k] as usize],
-                        verts[l[(k + 1) % l.len()] as usize],
-                        p,
-                    ) < clearance
-                })
-            });
-            if !near {
-                out.push(p);
-            }
-        }
-    }
-}
-
-/// Winding number of the closed loop around `p` (exact orientation tests).
-fn winding(verts: &[DVec2], l: &[u32], p: DVec2) -> i32 {
-    let mut w = 0;
-    for k in 0..l.len() {
-        let a = verts[l[k] as usize];
-        let b = verts[l[(k + 1) % l.len()] as usize];
-        if a.y <= p.y {
-            if b.y > p.y && orient(a, b, p) > 0.0 {
-                w += 1;
-            }
-        } else if b.y <= p.y && orient(a, b, p) < 0.0 {
-            w -= 1;
-        }
-    }
-    w
-}
-
-/// Triangles, their regions (connected components across non-constraint edges, classified
-/// once each), and the D0 vertex split.
-fn extract(
-    cdt: &Cdt,
-    shift: DVec2,
-    rr: &ReceiverRegions,
-    frame: &Frame,
-    uniform: bool,
-    tol: &Tolerances,
-) -> ReceiverMesh {
-    let nv = cdt.num_vertices();
-    let mut positions: Vec<DVec2> = cdt
-        .vertices()
-        .map(|v| DVec2::new(v.position().x, v.position().y) - shift)
-        .collect();
-    let faces: Vec<_> = cdt.inner_faces().collect();
-    // Spade numbers the outer face 0 and the inner faces from 1, in the order
-    // `inner_faces` visits them; a hash map from handle to position cost quads2000's
-    // floor (800k triangles) a second.
-    let face_index =
-        |f: spade::handles::FixedFaceHandle<spade::handles::InnerTag>| -> usize { f.index() - 1 };
-    debug_assert!(faces
-        .iter()
-        .enumerate()
-        .all(|(i, f)| face_index(f.fix()) == i));
-    let mut triangles: Vec<[u32; 3]> = faces
-        .iter()
-        .map(|f| f.vertices().map(|v| v.fix().index() as u32))
-        .collect();
-
-    // Components across unconstrained edges.
-    if uniform {
-        let mut tri_region = vec![0; triangles.len()];
-        drop_flat(&positions, frame, &mut triangles, &mut tri_region, tol);
-        return ReceiverMesh {
-            eval: positions.clone(),
-            positions,
-            triangles,
-            tri_region,
-            regions: Vec::new(),
-        };
-    }
-    let mut comp = vec![u32::MAX; faces.len()];
-    // The largest triangle of each component, whose centre is classified.
-    let mut largest: Vec<usize> = Vec::new();
-    for start in 0..faces.len() {
-        if comp[start] != u32::MAX {
-            continue;
-        }
-        let id = largest.len() as u32;
-        let mut stack = vec![start];
-        comp[start] = id;
-        let mut best = (0.0f64, start);
-        while let Some(i) = stack.pop() {
-            let area = faces[i].area();
-            if area > best.0 {
-                best = (area, i);
-            }
-            for e in faces[i].adjacent_edges() {
-                if e.is_constraint_edge() {
-                    continue;
-                }
-                if let Some(nb) = e.rev().face().as_inner() {
-                    let j = face_index(nb.fix());
-                    if comp[j] == u32::MAX {
-                        comp[j] = id;
-                        stack.push(j);
-                    }
-                }
-            }
-        }
-        largest.push(best.1);
-    }
-    // A dense receiver has hundreds of thousands of components, each classified on its own.
-    let centres: Vec<DVec2> = largest
-        .iter()
-        .map(|&t| {
-            let c = faces[t].center();
-            DVec2::new(c.x, c.y) - shift
-        })
-        .collect();
-    let regions: Vec<Region> = centres.par_iter().map(|&c| rr.classify(c)).collect();
-
-    // D0 split: group the triangles around each vertex into sectors that do not cross a
-    // lit|umbra edge; every sector but the first gets its own copy of the vertex.
-    let lit_umbra = |a: &Region, b: &Region| {
-        a.relations.iter().zip(&b.relations).any(|(x, y)| {
-            matches!(
-                (x, y),
-                (Relation::Lit, Relation::Umbra) | (Relation::Umbra, Relation::Lit)
-            )
-        })
-    };
-    let scale = positions
-        .iter()
-        .fold(0.0f64, |m, p| m.max(p.abs().max_element()))
-        .max(1e-300);
-    // Contacts and plane cuts: an occluder meets the receiver there, so light jumps even
-    // where both sides are in penumbra.
-    let on_contact = |p: DVec2, q: DVec2| {
-        rr.d0_lines
-            .iter()
-            .any(|&[a, b]| seg_dist(a, b, p) <= 1e-9 * scale && seg_dist(a, b, q) <= 1e-9 * scale)
-    };
-    let is_d0_edge = |e: spade::handles::DirectedEdgeHandle<
-        '_,
-        Point2<f64>,
-        (),
-        spade::CdtEdge<()>,
-        (),
-    >|
-     -> bool {
-        if !e.is_constraint_edge() {
-            return false;
-        }
-        let (Some(fa), Some(fb)) = (e.face().as_inner(), e.rev().face().as_inner()) else {
-            return false;
-        };
-        let (ca, cb) = (comp[face_index(fa.fix())], comp[face_index(fb.fix())]);
-        if ca == cb {
-            return false;
-        }
-        if lit_umbra(&regions[ca as usize], &regions[cb as usize]) {
-            return true;
-        }
-        let (p, q) = (e.from().position(), e.to().position());
-        on_contact(DVec2::new(p.x, p.y) - shift, DVec2::new(q.x, q.y) - shift)
-    };
-    let mut d0_vertices = Vec::new();
-    for e in cdt.undirected_edges() {
-        if !e.is_constraint_edge() {
-            continue;
-        }
-        let d = e.as_directed();
-        if is_d0_edge(d) {
-            d0_vertices.push(d.from().fix());
-            d0_vertices.push(d.to().fix());
-        }
-    }
-    let mut eval = positions.clone();
-    d0_vertices.sort_unstable();
-    d0_vertices.dedup();
-    for vh in d0_vertices {
-        let v = cdt.vertex(vh);
-        // Outgoing edges in order around the vertex; faces between consecutive edges.
-        let out: Vec<_> = v.out_edges().collect();
-        let n = out.len();
-        let mut sectors: Vec<Vec<usize>> = Vec::new();
-        let mut current: Vec<usize> = Vec::new();
-        // Start the walk just after a D0 edge so sectors do not wrap.
-        let cut = |k: usize| -> bool { is_d0_edge(out[k]) };
-        let Some(first_cut) = (0..n).find(|&k| cut(k)) else {
-            continue;
-        };
-        for s in 0..n {
-            let k = (first_cut + s) % n;
-            if s > 0 && cut(k) && !current.is_empty() {
-                sectors.push(std::mem::take(&mut current));
-            }
-            match out[k].face().as_inner() {
-                Some(f) => current.push(face_index(f.fix())),
-                // The receiver's boundary ends a sector too: on a boundary vertex the two
-                // sides of a D0 line meet again only across the outside.
-                None => {
-                    if !current.is_empty() {
-                        sectors.push(std::mem::take(&mut current));
-                    }
-                }
-            }
-        }
-        if !current.is_empty() {
-            sectors.push(current);
-        }
-        for (k, sector) in sectors.iter().enumerate() {
-            let id = if k == 0 {
-                vh.index() as u32
-            } else {
-                positions.push(positions[vh.index()]);
-                eval.push(positions[vh.index()]);
-                positions.len() as u32 - 1
-            };
-            // Nudge the evaluation point towards the sector's triangles.
-            let p = positions[vh.index()];
-            let mut dir = DVec2::ZERO;
-            let mut shortest = f64::INFINITY;
-            for &t in sector {
-                let c = triangles[t]
-                    .iter()
-                    .map(|&i| positions[i as usize])
-                    .sum::<DVec2>()
-                    / 3.0;
-                dir += (c - p).normalize_or_zero();
-                for &i in &triangles[t] {
-                    let d = (positions[i as usize] - p).length();
-                    if d > 0.0 {
-                        shortest = shortest.min(d);
-                    }
-                }
-            }
-            if dir != DVec2::ZERO && shortest.is_finite() {
-                let step = (shortest * 1e-6).max(tol.d0_offset).min(0.25 * shortest);
-                eval[id as usize] = p + dir.normalize() * step;
-            }
-            if k > 0 {
-                for &t in sector {
-                    for x in triangles[t].iter_mut() {
-                        if *x == vh.index() as u32 {
-                            *x = id;
-                        }
-                    }
-                }
-            }
-        }
-    }
-    let _ = nv;
-    let mut tri_region = comp;
-    drop_flat(&positions, frame, &mut triangles, &mut tri_region, tol);
-    ReceiverMesh {
-        positions,
-        eval,
-        triangles,
-        tri_region,
-        regions,
-    }
-}
-
-/// Removes triangles narrower than 1e-12 of the scene size (twice the area over the longest
-/// side). Spade splits constraint edges at computed points (midpoints when refining) that
-/// lie an ulp or so off the exact line; its exact predicates then see a kink there, keep
-/// triangles spanned by three points of one line (e.g. filling the dent the kink makes in
-/// the hull), and refinement near a kink can run away, halving ever thinner triangles. Such
-/// a triangle is a thousand times narrower than the distance below which the arrangement
-/// merges points (~1e-9 of the scene), so it stands for no discontinuity; it carries no
-/// light (area under 1e-12 × scene × its length), and its facing is decided by rounding,
-/// so in 3-D it may point against its polygon. Dropping it leaves a slit of that width. It
-/// is done after the D0 split so that, while sectors and regions are formed, it still joins
-/// its neighbours.
-fn drop_flat(
-    positions: &[DVec2],
-    frame: &Frame,
-    triangles: &mut Vec<[u32; 3]>,
-    tri_region: &mut Vec<u32>,
-    tol: &Tolerances,
-) {
-    // Judged in 3-D: far from the origin, points apart in the receiver's frame can round
-    // to one point in the scene.
-    let p3: Vec<DVec3> = positions.iter().map(|p| frame.to_3d(*p)).collect();
-    let scale = p3.iter().fold(0.0f64, |m, p| m.max(p.abs().max_element()));
-    // Rounding alone moves a point off a line by a few ulps of the coordinates.
-    let tol = (64.0 * f64::EPSILON * scale).max(tol.flat);
-    let keep: Vec<bool> = triangles
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| p3[i as usize]);
-            let longest = (b - a).length().max((c - b).length()).max((a - c).length());
-            (b - a).cross(c - a).length() > tol * longest
-        })
-        .collect();
-    if keep.iter().all(|&k| k) {
-        return;
-    }
-    let mut k = keep.iter();
-    triangles.retain(|_| *k.next().unwrap_or(&true));
-    let mut k = keep.iter();
-    tri_region.retain(|_| *k.next().unwrap_or(&true));
 }

@@ -103,6 +103,10 @@ pub struct SettingsJson {
     pub patch_size: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min_angle: Option<f64>,
+    /// Relative error of the baked direct light at any point against the exact light
+    /// (default 0.01): elements are split until they meet it (`mesh::refine`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tolerance: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_elements: Option<u64>,
     /// Bytes the bake may use, at most by the resource model's estimate (default: half the

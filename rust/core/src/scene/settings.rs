@@ -31,6 +31,8 @@ pub struct Settings {
     pub patch_size: f64,
     /// Smallest inner angle that refinement aims for (degrees).
     pub min_angle: f64,
+    /// Relative error of the baked direct light that refinement aims for (`mesh::refine`).
+    pub tolerance: f64,
     pub max_elements: u64,
     /// Bytes the bake may use by the resource model's estimate (`scene::resources`).
     pub max_memory: u64,
@@ -50,6 +52,10 @@ pub struct Settings {
     pub world: glam::DVec3,
 }
 
+pub const DEFAULT_TOLERANCE: f64 = 0.01;
+/// Below this the exact light's own rounding (the polygon booleans snap at ~1e-9 of the
+/// scene) would drive the split.
+pub const MIN_TOLERANCE: f64 = 1e-5;
 pub const DEFAULT_MAX_ELEMENTS: u64 = 4_000_000;
 /// Largest `threads` accepted (the CLI's `--threads` too): past it a pool only costs memory.
 pub const MAX_THREADS: u32 = 1024;
@@ -88,6 +94,13 @@ impl Settings {
             return Err(BakeError::setting(
                 "min_angle",
                 format!("{min_angle} must be in [0, 33] degrees"),
+            ));
+        }
+        let tolerance = s.tolerance.unwrap_or(DEFAULT_TOLERANCE);
+        if !(tolerance.is_finite() && (MIN_TOLERANCE..=1.0).contains(&tolerance)) {
+            return Err(BakeError::setting(
+                "tolerance",
+                format!("{tolerance} must be in [{MIN_TOLERANCE:e}, 1]"),
             ));
         }
         let max_elements = s.max_elements.unwrap_or(DEFAULT_MAX_ELEMENTS);
@@ -180,6 +193,7 @@ impl Settings {
             penumbra_element_size,
             patch_size,
             min_angle,
+            tolerance,
             max_elements,
             max_memory,
             indirect: s.indirect.unwrap_or(true),
