@@ -453,3 +453,18 @@ mod hull_test {
         assert!((signed_area_2d(&h) - 1.0).abs() < 1e-15);
     }
 }
+
+/// Triangle `t` cut into four at its edges' midpoints.
+pub fn split_in_four(t: &[DVec3; 3]) -> [[DVec3; 3]; 4] {
+    let m = [
+        (t[0] + t[1]) * 0.5,
+        (t[1] + t[2]) * 0.5,
+        (t[2] + t[0]) * 0.5,
+    ];
+    [
+        [t[0], m[0], m[2]],
+        [m[0], t[1], m[1]],
+        [m[2], m[1], t[2]],
+        [m[0], m[1], m[2]],
+    ]
+}

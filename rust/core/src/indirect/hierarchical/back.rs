@@ -36,6 +36,7 @@ use glam::{DVec2, DVec3};
 use super::hierarchy::Hierarchy;
 use super::link::receiver_triangles;
 use crate::geom::frame::Frame;
+use crate::geom::polygon::split_in_four;
 use crate::geom::raycast::Occluders;
 use crate::mesh::elements::Elements;
 use crate::progress::Progress;
@@ -194,7 +195,7 @@ pub fn set_direct(
         let mut next = Vec::new();
         for (&(k, t, w, depth), v) in items.iter().zip(e.chunks_exact(6)) {
             if split_now && depth > 0 && splitting(v) {
-                next.extend(split(&t).map(|q| (k, q, 0.25 * w, depth - 1)));
+                next.extend(split_in_four(&t).map(|q| (k, q, 0.25 * w, depth - 1)));
                 continue;
             }
             sum[k as usize] += (v[0] + v[1] + v[2]) * (w / 3.0);
@@ -214,21 +215,6 @@ pub fn set_direct(
 fn rule_points(t: &[DVec3; 3]) -> [DVec3; 3] {
     [[4.0, 1.0, 1.0], [1.0, 4.0, 1.0], [1.0, 1.0, 4.0]]
         .map(|[a, b, c]| (t[0] * a + t[1] * b + t[2] * c) / 6.0)
-}
-
-/// Triangle `t` cut into four at its edges' midpoints.
-fn split(t: &[DVec3; 3]) -> [[DVec3; 3]; 4] {
-    let m = [
-        (t[0] + t[1]) * 0.5,
-        (t[1] + t[2]) * 0.5,
-        (t[2] + t[0]) * 0.5,
-    ];
-    [
-        [t[0], m[0], m[2]],
-        [m[0], t[1], m[1]],
-        [m[2], m[1], t[2]],
-        [m[0], m[1], m[2]],
-    ]
 }
 
 #[cfg(test)]

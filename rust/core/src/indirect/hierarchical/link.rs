@@ -18,6 +18,7 @@ use glam::{DVec3, Vec3};
 use super::hierarchy::{Hierarchy, Node};
 use crate::geom::edge_soup::clip_front;
 use crate::geom::lambert::{edges_irradiance, polygon_irradiance};
+use crate::geom::polygon::split_in_four;
 use crate::geom::polygon_factor::edges_coupling;
 use crate::mesh::elements::Elements;
 use crate::scene::Face;
@@ -440,28 +441,14 @@ pub(super) fn triangle_mean(f: &impl Fn(DVec3) -> f64, t: [DVec3; 3], depth: u32
             .sum::<f64>()
             / 3.0
     };
-    let split = |t: &[DVec3; 3]| {
-        let m = [
-            (t[0] + t[1]) * 0.5,
-            (t[1] + t[2]) * 0.5,
-            (t[2] + t[0]) * 0.5,
-        ];
-        [
-            [t[0], m[0], m[2]],
-            [m[0], t[1], m[1]],
-            [m[2], m[1], t[2]],
-            [m[0], m[1], m[2]],
-        ]
-    };
     fn go(
         f: &impl Fn(DVec3) -> f64,
         t: [DVec3; 3],
         coarse: f64,
         depth: u32,
         rule: &impl Fn(&[DVec3; 3]) -> f64,
-        split: &impl Fn(&[DVec3; 3]) -> [[DVec3; 3]; 4],
     ) -> f64 {
-        let kids = split(&t);
+        let kids = split_in_four(&t);
         let vals = kids.map(|k| rule(&k));
         let fine = vals.iter().sum::<f64>() / 4.0;
         if depth == 0 || (fine - coarse).abs() <= MEAN_TOL * fine.abs().max(1e-12) {
@@ -469,7 +456,7 @@ pub(super) fn triangle_mean(f: &impl Fn(DVec3) -> f64, t: [DVec3; 3], depth: u32
         }
         kids.iter()
             .zip(vals)
-            .map(|(k, v)| go(f, *k, v, depth - 1, rule, split))
+            .map(|(k, v)| go(f, *k, v, depth - 1, rule))
             .sum::<f64>()
             / 4.0
     }
@@ -477,7 +464,7 @@ pub(super) fn triangle_mean(f: &impl Fn(DVec3) -> f64, t: [DVec3; 3], depth: u32
     if depth == 0 {
         return coarse;
     }
-    go(f, t, coarse, depth - 1, &rule, &split)
+    go(f, t, coarse, depth - 1, &rule)
 }
 
 /// Levels a point-to-node factor may descend into a near planar source.
