@@ -158,6 +158,8 @@ pub(crate) fn refine(
             .collect()
     };
     stats.elements_before = check.len() as u64;
+    // The faces around what the last pass changed, to be checked in this one.
+    let mut around: Option<Vec<Face>> = None;
     loop {
         progress.check()?;
         let view = View {
@@ -168,6 +170,25 @@ pub(crate) fn refine(
             outside: &outside,
             test: &test,
         };
+        if let Some(around) = around.take() {
+            // The triangles around what changed are checked again, and their neighbours
+            // too, whose screening sees new gradients.
+            let mut mark = vec![false; cdt.num_all_faces()];
+            check.clear();
+            for &f in &around {
+                if view.inside(f) && !std::mem::replace(&mut mark[f.index()], true) {
+                    check.push(f);
+                }
+            }
+            for k in 0..check.len() {
+                let f = check[k];
+                for n in view.neighbours(f).collect::<Vec<_>>() {
+                    if view.inside(n) && !std::mem::replace(&mut mark[n.index()], true) {
+                        check.push(n);
+                    }
+                }
+            }
+        }
         let found = check_faces(
             &view,
             &check,
@@ -219,32 +240,14 @@ pub(crate) fn refine(
         touched.extend((before..cdt.num_vertices()).map(FixedVertexHandle::from_index));
         touched.sort_unstable();
         touched.dedup();
-        let around = label_new_faces(cdt, &touched, rr, shift, &mut regions, &mut outside);
-        // The triangles around what changed are checked again, and their neighbours too,
-        // whose screening sees new gradients.
-        let view = View {
+        around = Some(label_new_faces(
             cdt,
+            &touched,
+            rr,
             shift,
-            tol,
-            regions: &regions,
-            outside: &outside,
-            test: &test,
-        };
-        let mut mark = vec![false; cdt.num_all_faces()];
-        check.clear();
-        for &f in &around {
-            if view.inside(f) && !std::mem::replace(&mut mark[f.index()], true) {
-                check.push(f);
-            }
-        }
-        for k in 0..check.len() {
-            let f = check[k];
-            for n in view.neighbours(f).collect::<Vec<_>>() {
-                if view.inside(n) && !std::mem::replace(&mut mark[n.index()], true) {
-                    check.push(n);
-                }
-            }
-        }
+            &mut regions,
+            &mut outside,
+        ));
     }
     debug_assert!(labels_agree(cdt, &regions));
     let comp: Vec<u32> = cdt.inner_faces().map(|f| f.data().0).collect();
