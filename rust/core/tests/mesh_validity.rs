@@ -400,6 +400,18 @@ fn random_scenes_give_valid_meshes() {
     assert!(tiny * 100 <= tris, "{tiny} of {tris} triangles are tiny");
 }
 
+/// Random scene 129: with the lower size bound shrinking with the receiver, a refinement pass
+/// whose only split changed faces without adding a vertex left those faces unlabelled, and
+/// extraction indexed regions with `u32::MAX` (a panic). Faces are now labelled before the
+/// pass may end the loop.
+#[test]
+fn a_pass_that_adds_no_vertex_leaves_no_face_unlabelled() {
+    let s = random_scene(129);
+    let mut tiny = 0;
+    let n = check_mesh_validity(&s, &bake(&s), "seed 129", &mut tiny);
+    assert!(n > 100, "{n} triangles");
+}
+
 /// Checks the bake of the scene JSON files listed (colon-separated) in MESH_VALIDITY_SCENES,
 /// e.g. built-in scenes written by `penumbra scene NAME -o FILE`.
 #[test]

@@ -15,6 +15,11 @@ use penumbra::scene::settings::PenumbraVisibility;
 use penumbra::scene::solids::Occluder;
 use penumbra::scene::{LightKind, Scene};
 
+/// Refinement's lower size bound, as `mesh::refine::LOWER_BOUND` (of
+/// `penumbra_element_size`) and `RECEIVER_LOWER` (of the receiver's extent).
+const LOWER_BOUND: f64 = 1.0 / 16.0;
+const RECEIVER_LOWER: f64 = 1.0 / 64.0;
+
 /// The floor of the bound, as `mesh::refine::FLOOR`: a fraction of the brightest vertex of
 /// the receiver (here of the source polygon, whose brightest is at least the piece's).
 const FLOOR: f64 = 0.01;
@@ -132,7 +137,6 @@ struct Measured {
 fn measure(s: &SceneJson, seed: u64) -> Measured {
     let sc = penumbra::scene::validate(s).expect("valid scene");
     let tolerance = sc.settings.tolerance;
-    let lower = sc.settings.penumbra_element_size / 16.0;
     let b = bake(s);
     let mut rng = Rng(seed);
     let (mut worst, mut checked, mut skipped, mut slivers, mut sum2) = (0.0f64, 0, 0, 0, 0.0);
@@ -148,6 +152,24 @@ fn measure(s: &SceneJson, seed: u64) -> Measured {
             .map(|c| DVec3::from_array(*c) * std::f64::consts::PI)
             .collect();
         let npoly = m.source_polygon.iter().max().map_or(0, |x| *x as usize + 1);
+        // Refinement's lower size bound per receiver (`mesh::refine::lower_bound`), here
+        // from the source polygon's box diagonal, which is at least the receiver's extent in
+        // its plane: the bound used here is never below refinement's.
+        let mut boxes = vec![(DVec3::INFINITY, DVec3::NEG_INFINITY); npoly];
+        for (t, tri) in m.triangles.iter().enumerate() {
+            let b = &mut boxes[m.source_polygon[t] as usize];
+            for &v in tri {
+                let p = DVec3::from_array(m.positions[v as usize]);
+                *b = (b.0.min(p), b.1.max(p));
+            }
+        }
+        let lower: Vec<f64> = boxes
+            .iter()
+            .map(|(lo, hi)| {
+                (sc.settings.penumbra_element_size * LOWER_BOUND)
+                    .min((*hi - *lo).length() * RECEIVER_LOWER)
+            })
+            .collect();
         let mut floor = vec![DVec3::ZERO; npoly];
         for (t, tri) in m.triangles.iter().enumerate() {
             let f = &mut floor[m.source_polygon[t] as usize];
@@ -161,7 +183,7 @@ fn measure(s: &SceneJson, seed: u64) -> Measured {
                 .length()
                 .min((p[2] - p[1]).length())
                 .min((p[0] - p[2]).length());
-            if shortest < 2.0 * lower {
+            if shortest < 2.0 * lower[m.source_polygon[t] as usize] {
                 skipped += 1;
                 continue;
             }
@@ -225,7 +247,15 @@ fn meets_tolerance(name: &str) {
 }
 
 fn scene_meets_tolerance(name: &str, s: &SceneJson) {
+    scene_meets_tolerance_at(name, s, &[0, 1, 2]);
+}
+
+/// `scene_meets_tolerance` for the presets numbered `which` in `PRESETS`.
+fn scene_meets_tolerance_at(name: &str, s: &SceneJson, which: &[usize]) {
     for (k, (preset_name, tolerance, fractions)) in PRESETS.iter().enumerate() {
+        if !which.contains(&k) {
+            continue;
+        }
         let m = measure(&preset(s, *tolerance, *fractions), 7 + k as u64);
         eprintln!(
             "{name} {preset_name}: worst {:.3} of the bound, rms {:.2e}, {} elements checked, {} at the lower bound, {} slivers, {} inside solids; worst in {}",
@@ -283,6 +313,43 @@ fn leg_under_an_overhang_meets_its_tolerance() {
         SettingsJson::default(),
     );
     scene_meets_tolerance("leg", &s);
+}
+
+/// Clutter: small boxes a few millimetres apart on a table, under a light off to one side.
+/// Their faces catch each other's penumbrae, a few millimetres wide. With a lower size bound
+/// set by the scene alone (1/800 of its diagonal), the elements across those penumbrae could
+/// not be split: room-78's clutter faces were 2.5× the light at some probes, with exact
+/// corners. The bound now shrinks with the receiver (`mesh::refine::RECEIVER_LOWER`): draft
+/// went from 55× the tolerance to 0.38×, medium is 0.88×.
+#[test]
+fn clutter_meets_its_tolerance() {
+    scene_meets_tolerance_at("clutter", &clutter(), &[0, 1]);
+}
+
+/// Open (issue 13): at the high preset, triangles 1e-7 high and 2 mm long along the line
+/// where a box stands on the table (between the line and vertices a hair above it) count as
+/// flat (`mesh::refine::FLAT`) and are never split: 6.2× the tolerance there.
+#[test]
+#[ignore = "open (issue 13): flat strips along a box's contact line are not split (high: 6.2× the tolerance)"]
+fn clutter_meets_its_tolerance_at_high() {
+    scene_meets_tolerance_at("clutter", &clutter(), &[2]);
+}
+
+fn clutter() -> SceneJson {
+    let mut boxes = cuboid([0.0, 0.0, 0.0], [0.03, 0.03, 0.03]);
+    boxes.extend(cuboid([0.033, 0.004, 0.0], [0.06, 0.028, 0.05]));
+    boxes.extend(cuboid([0.005, 0.034, 0.0], [0.025, 0.05, 0.02]));
+    scene(
+        vec![
+            mesh("Table", vec![quad([0.03, 0.03, 0.0], 0.6, 0.6, true)]),
+            mesh("Clutter", boxes),
+        ],
+        vec![area_light(
+            "Lamp",
+            quad([0.25, 0.15, 0.8], 0.15, 0.15, false),
+        )],
+        SettingsJson::default(),
+    )
 }
 
 #[test]

@@ -9,7 +9,7 @@ use spade::Triangulation;
 
 use super::doubt;
 use super::readings::{Kind, View};
-use super::refine::{key, lower_bound, Cache, Lights, RefineStats, FLOOR, SAFETY};
+use super::refine::{key, Cache, Lights, RefineStats, FLOOR, SAFETY};
 use super::sides::Face;
 use crate::regions::relation::Relation;
 use crate::regions::Region;
@@ -33,13 +33,13 @@ pub(super) fn check_faces(
     cache: &mut Cache,
     brightest: &mut DVec3,
     settings: &Settings,
+    lower: f64,
     lights: &Lights,
     stats: &mut RefineStats,
     progress: &crate::Progress,
 ) -> Result<Option<Splits>, BakeError> {
     let cdt = view.cdt;
     let light = lights.at;
-    let lower = lower_bound(settings);
     // Faces whose corner values are needed: those checked and their neighbours.
     let mut slot = vec![u32::MAX; cdt.num_all_faces()];
     let mut faces: Vec<Face> = Vec::with_capacity(check.len() * 2);

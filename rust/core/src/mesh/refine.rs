@@ -75,9 +75,34 @@ pub struct RefineStats {
     pub evaluations: u64,
 }
 
-/// The lower size bound for `settings`.
-pub fn lower_bound(settings: &Settings) -> f64 {
-    settings.penumbra_element_size * LOWER_BOUND
+/// ... and at most this fraction of the receiver's extent: a small object (clutter on a
+/// table) catches penumbrae of its own size, from its neighbours a few mm away, which a
+/// bound set by the scene's size leaves unresolved (room-78 direct at 1 %: its worst probes
+/// were 2.5× the light on clutter faces, in elements at the bound, with exact corners).
+pub const RECEIVER_LOWER: f64 = 1.0 / 64.0;
+
+/// The lower size bound for `settings` on a receiver `extent` across.
+pub fn lower_bound(settings: &Settings, extent: f64) -> f64 {
+    let global = settings.penumbra_element_size * LOWER_BOUND;
+    if extent > 0.0 {
+        global.min(extent * RECEIVER_LOWER)
+    } else {
+        global
+    }
+}
+
+/// The larger side of the bounding box of `points`.
+fn extent(points: &[DVec2]) -> f64 {
+    let (lo, hi) = points.iter().fold(
+        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    );
+    let d = hi - lo;
+    if d.x.is_finite() && d.y.is_finite() {
+        d.x.max(d.y)
+    } else {
+        0.0
+    }
 }
 
 pub(super) fn key(p: DVec2) -> [u64; 2] {
@@ -149,6 +174,7 @@ pub(crate) fn refine(
     }
     drop(comp);
     let test = D0Test::new(rr, scale(cdt, shift), shift);
+    let lower = lower_bound(settings, extent(&rr.arrangement.vertices));
     let mut kinds: Vec<Kind> = Vec::new();
     let mut brightest = DVec3::ZERO;
     let mut check: Vec<Face> = {
@@ -196,6 +222,7 @@ pub(crate) fn refine(
             &mut cache,
             &mut brightest,
             settings,
+            lower,
             lights,
             &mut stats,
             progress,
@@ -232,14 +259,11 @@ pub(crate) fn refine(
         budget.fetch_add(added, Ordering::Relaxed);
         stats.passes += 1;
         stats.vertices_added += added;
-        // Every split was refused (kinked constraints, rounding): the next pass would find
-        // the same elements.
-        if added == 0 {
-            break;
-        }
         touched.extend((before..cdt.num_vertices()).map(FixedVertexHandle::from_index));
         touched.sort_unstable();
         touched.dedup();
+        // A split that adds no vertex may still have changed faces (a constraint split
+        // whose helper vertex came and went): they are labelled before any exit.
         around = Some(label_new_faces(
             cdt,
             &touched,
@@ -248,6 +272,11 @@ pub(crate) fn refine(
             &mut regions,
             &mut outside,
         ));
+        // Every split was refused (kinked constraints, rounding): the next pass would find
+        // the same elements.
+        if added == 0 {
+            break;
+        }
     }
     debug_assert!(labels_agree(cdt, &regions));
     let comp: Vec<u32> = cdt.inner_faces().map(|f| f.data().0).collect();
