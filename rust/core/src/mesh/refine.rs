@@ -93,10 +93,7 @@ pub fn lower_bound(settings: &Settings, extent: f64) -> f64 {
 
 /// The larger side of the bounding box of `points`.
 fn extent(points: &[DVec2]) -> f64 {
-    let (lo, hi) = points.iter().fold(
-        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
-        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-    );
+    let (lo, hi) = crate::geom::box_grid::bounds(points);
     let d = hi - lo;
     if d.x.is_finite() && d.y.is_finite() {
         d.x.max(d.y)
