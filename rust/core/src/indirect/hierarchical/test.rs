@@ -402,9 +402,26 @@ fn bit_identical_for_any_thread_count() {
             .collect::<Vec<_>>()
     };
     assert_eq!(bits(&runs[0]), bits(&runs[1]));
-    // The plate's shadow on the floor is there (points under it darker than in the open).
-    let expect = PI * 0.2 / 0.4;
-    assert!(runs[0].irradiance.iter().any(|e| e.x < 0.9 * expect));
+    // The plate's shadow on the floor is there: the floor under the plate's middle sees its
+    // back (ρ = 0.8, lit by the floor: B ≈ 0.78 of the furnace value) over a factor of about
+    // 0.2 in place of walls at about 0.97, so it is about 4 % darker than the open floor.
+    // Measured 1.2 % (0.04 % from the links' mean visibility alone); the plate is one face
+    // of a cluster, whose links carry their mean. (This once asked for any vertex under 0.9
+    // of the furnace value: one on the wall beside the plate had 0.897 from its links' mean
+    // visibility, where rays from the vertex find the opposite wall under the plate in full
+    // view; the darkest vertex is now at 0.925.)
+    let el = grid_elements(&sc.faces, 5);
+    let floor_mean = |keep: &dyn Fn(DVec3) -> bool| {
+        let xs: Vec<f64> = (0..el.positions.len())
+            .filter(|&i| el.vertex_face[i] == 0 && keep(el.positions[i]))
+            .map(|i| runs[0].irradiance[i].x)
+            .collect();
+        xs.iter().sum::<f64>() / xs.len() as f64
+    };
+    let under = floor_mean(&|p| (p - v(0.5, 0.4, 0.0)).length() < 0.15);
+    let open = floor_mean(&|p| !(0.2..0.8).contains(&p.x) || !(0.1..0.7).contains(&p.y));
+    eprintln!("under the plate {under:.4}, open floor {open:.4}");
+    assert!(under < 0.99 * open, "{under} vs {open}");
 }
 
 #[test]
@@ -465,6 +482,11 @@ fn many_occluders_go_through_the_bvh() {
     }
     assert!(ratios.iter().all(|r| (r - 0.4).abs() < 0.1), "{ratios:?}");
     let mean = ratios.iter().sum::<f64>() / ratios.len() as f64;
+    eprintln!(
+        "slats: mean {mean} min {} max {}",
+        ratios.iter().cloned().fold(9.0, f64::min),
+        ratios.iter().cloned().fold(0.0, f64::max)
+    );
     assert!((mean - 0.4).abs() < 0.03, "{mean}");
 }
 
