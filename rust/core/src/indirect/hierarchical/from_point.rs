@@ -91,40 +91,59 @@ impl Seen {
     }
 }
 
-/// `k` stratified segments from the point `at` = (position, normal, scene face) to node `s`,
-/// drawn from the stream `seed` (a different seed gives independent strata). `blockers`
-/// holds every face that could cross one (`Visibility::blockers`), or `None` for the BVH.
+/// Where segments start: one point (position, normal, scene face), or stratified points of
+/// a planar node.
+#[derive(Clone, Copy)]
+pub enum Start<'a> {
+    Point(DVec3, DVec3, u32),
+    Node(&'a Node),
+}
+
+/// `k` stratified segments from `start` to node `s`, drawn from the stream `seed` (a
+/// different seed gives independent strata). `blockers` holds every face that could cross
+/// one (`Visibility::blockers`), or `None` for the BVH.
 pub fn seen_from(
     vis: &Visibility,
     table: &AreaTable,
-    at: (DVec3, DVec3, u32),
+    start: Start,
     s: &Node,
     blockers: Option<&[u32]>,
     k: u32,
     seed: u64,
 ) -> Seen {
-    let (p, n, face) = at;
     let h = vis.h;
+    let face = match start {
+        Start::Point(_, _, f) => f,
+        Start::Node(r) => h.real_face(r.face),
+    };
     let mut skip = [face, face];
     if s.is_planar() {
         skip[1] = h.real_face(s.face);
     }
     let mut out = Seen::default();
-    if s.hi <= s.lo {
+    if s.hi <= s.lo || matches!(start, Start::Node(r) if r.hi <= r.lo) {
         return out;
     }
     let k = k.max(1);
     for i in 0..k {
         let r = mix(seed ^ mix(i as u64 + 1));
-        let (xi1, xi2) = (unit(r), unit(mix(r)));
-        let (pos, t) = table.at(s, (i as f64 + xi1) / k as f64);
-        let tri = h.order[pos as usize] as usize;
-        let [a, b, c] = vis.el.triangles[tri].map(|v| vis.el.positions[v as usize]);
-        let st = t.sqrt();
-        let y = a * (1.0 - st) + b * (st * (1.0 - xi2)) + c * (st * xi2);
-        // The leaf's face, not the triangle's: a back leaf faces the other way.
-        let leaf_face = h.nodes[h.leaf_node[pos as usize] as usize].face;
-        let ny = vis.faces[leaf_face as usize].plane.n;
+        let (y, ny) = point_of(vis, table, s, (i as f64 + unit(r)) / k as f64, unit(mix(r)));
+        let (p, n) = match start {
+            Start::Point(p, n, _) => (p, n),
+            // The start's strata in another order (7 is prime to the powers of two the
+            // counts are), so that the pairs do not run side by side across the two nodes.
+            Start::Node(rn) => {
+                let j = (i as u64 * 7 + 3) % k as u64;
+                let q = mix(r ^ 0x5851_f42d_4c95_7f2d);
+                point_of(
+                    vis,
+                    table,
+                    rn,
+                    (j as f64 + unit(q)) / k as f64,
+                    unit(mix(q)),
+                )
+            }
+        };
         let d = y - p;
         let (ca, cb) = (n.dot(d), -ny.dot(d));
         if !(ca > 0.0 && cb > 0.0) {
@@ -147,6 +166,20 @@ pub fn seen_from(
         }
     }
     out
+}
+
+/// The point of node `n` at the fraction `u` of its area (`AreaTable`), the part of its
+/// triangle's share that `u` falls at and `v` its coordinates in the triangle, with its
+/// leaf's normal (a back leaf faces the other way from its triangle).
+fn point_of(vis: &Visibility, table: &AreaTable, n: &Node, u: f64, v: f64) -> (DVec3, DVec3) {
+    let h = vis.h;
+    let (pos, t) = table.at(n, u);
+    let tri = h.order[pos as usize] as usize;
+    let [a, b, c] = vis.el.triangles[tri].map(|i| vis.el.positions[i as usize]);
+    let st = t.sqrt();
+    let y = a * (1.0 - st) + b * (st * (1.0 - v)) + c * (st * v);
+    let leaf_face = h.nodes[h.leaf_node[pos as usize] as usize].face;
+    (y, vis.faces[leaf_face as usize].plane.n)
 }
 
 /// splitmix64's finaliser: a well-mixed 64-bit hash.

@@ -16,7 +16,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::from_point::{mix, seen_from, AreaTable, Seen};
+use super::from_point::{mix, seen_from, AreaTable, Seen, Start};
 use super::hierarchy::{Hierarchy, Node, NONE};
 use super::link::{planar_gather, point_coefficient};
 use super::solve::{Gathering, Radiosity, Solver};
@@ -26,7 +26,7 @@ use crate::scene::Face;
 
 /// Rays that screen a link whose own rays all agreed (v = 0 or 1): a vertex whose rays all
 /// agree too keeps the link's value.
-const SCREEN_RAYS: u32 = 4;
+const SCREEN_RAYS: u32 = 8;
 /// Rays from a vertex to a source that it checks in full; a vertex whose rays leave it in
 /// doubt (see `own_visibility`) casts as many again, up to `MAX_VERTEX_RAYS` in all.
 const REPLACE_RAYS: u32 = 16;
@@ -104,10 +104,7 @@ pub fn gathered(
                 chain.push(a);
                 a = parent[a as usize];
             }
-            let mut shafts = Shafts::default();
-            grp.iter()
-                .map(|&(leaf, v)| (v, gather.at(v, leaf, &chain, &mut shafts)))
-                .collect()
+            gather.leaf(grp[0].0, &chain, grp)
         })
         .collect();
     let mut out = vec![DVec3::ZERO; nv];
@@ -115,13 +112,6 @@ pub fn gathered(
         out[v as usize] = e;
     }
     out
-}
-
-/// Per source, what may stand between a leaf and it (`Visibility::blockers`), found once
-/// for the leaf's vertices: `Some(empty)` when nothing can, `None` when too much to list.
-#[derive(Default)]
-struct Shafts {
-    of: Vec<(u32, Option<Vec<u32>>)>,
 }
 
 struct Gather<'a> {
@@ -138,13 +128,161 @@ struct Gather<'a> {
     table: AreaTable,
 }
 
+/// A link above a leaf from a planar source whose visibility is a mean (`Link::clear`
+/// false), or whose rays were all blocked.
+struct Unsure {
+    source: u32,
+    /// The link's visibility, and the leaf's own where it looked.
+    v: f64,
+    /// The leaf's rays found the source in part: its vertices may differ.
+    varies: bool,
+    /// What may stand between the leaf and the source (`Visibility::blockers`), once found.
+    blockers: Option<Option<Vec<u32>>>,
+    /// The link's coefficient unhidden, for a link left out of the solve (else 0).
+    hidden_k: f64,
+}
+
 impl Gather<'_> {
-    /// Irradiance at vertex `v` of leaf `leaf`, whose ancestors from itself up are `chain`.
-    fn at(&self, v: u32, leaf: u32, chain: &[u32], shafts: &mut Shafts) -> DVec3 {
-        let (h, faces, el, g, hidden) = (self.h, self.faces, self.el, self.g, self.hidden);
-        let bm = &self.b.mean;
-        let of =
-            |g: &Gathering, a: u32| g.start[a as usize] as usize..g.start[a as usize + 1] as usize;
+    fn links(&self, g: &'_ Gathering, a: u32) -> std::ops::Range<usize> {
+        g.start[a as usize] as usize..g.start[a as usize + 1] as usize
+    }
+
+    /// What the planar source `s` gives the point `p` (normal `n`) unhidden.
+    fn unhidden(&self, p: DVec3, n: DVec3, s: u32) -> DVec3 {
+        let ns = self.faces[self.h.nodes[s as usize].face as usize].plane.n;
+        planar_gather(self.h, self.el, p, n, s, ns, &self.b.mean)
+    }
+
+    /// Irradiance at the vertices `verts` (leaf, vertex) of `leaf`, whose ancestors from
+    /// itself up are `chain`: first the leaf looks at the links it is least sure of, then
+    /// each vertex at those the leaf found in part.
+    fn leaf(&self, leaf: u32, chain: &[u32], verts: &[(u32, u32)]) -> Vec<(u32, DVec3)> {
+        let (h, faces, g, hidden) = (self.h, self.faces, self.g, self.hidden);
+        let ln = &h.nodes[leaf as usize];
+        let n = faces[ln.face as usize].plane.n;
+        let mut unsure: Vec<Unsure> = Vec::new();
+        for &a in chain {
+            for l in &g.links[self.links(g, a)] {
+                if !l.clear && h.nodes[l.source as usize].is_planar() {
+                    unsure.push(Unsure {
+                        source: l.source,
+                        v: l.v as f64,
+                        varies: false,
+                        blockers: None,
+                        hidden_k: 0.0,
+                    });
+                }
+            }
+            // A link whose few rays were all blocked is left out of the solve, but a vertex
+            // may see its source: links through slats that hide 60 % have all 4 rays blocked
+            // one time in eight, and vertices that took their own visibility for the other
+            // links only were 11 % too dark.
+            for l in &hidden.links[self.links(hidden, a)] {
+                if h.nodes[l.source as usize].is_planar() {
+                    unsure.push(Unsure {
+                        source: l.source,
+                        v: 0.0,
+                        varies: false,
+                        blockers: None,
+                        hidden_k: l.k as f64,
+                    });
+                }
+            }
+        }
+        // The leaf's look, at its centroid's values: the largest errors first, until what
+        // is left is under the tolerance of the darkest vertex's light.
+        if !unsure.is_empty() {
+            let c = ln.centroid;
+            let (e, errs) = self.gathered_at(c, n, chain, &unsure, |u, x| {
+                if u.hidden_k > 0.0 {
+                    (self.b.mean[u.source as usize] * u.hidden_k).element_sum()
+                } else {
+                    x.element_sum() * u.v.max(1.0 - u.v)
+                }
+            });
+            let darkest = verts
+                .iter()
+                .map(|&(_, v)| self.direct[v as usize].element_sum())
+                .fold(f64::INFINITY, f64::min);
+            let allowed = self.tolerance * (e.element_sum() + darkest);
+            for i in by_error(&errs, allowed) {
+                let u = &mut unsure[i];
+                let s = &h.nodes[u.source as usize];
+                let list = self.vis.blockers(ln, s);
+                let seed = mix(mix(NONE as u64 ^ leaf as u64) ^ u.source as u64);
+                let (v, varies) = own_visibility(
+                    self.vis,
+                    &self.table,
+                    Start::Node(ln),
+                    s,
+                    list.as_deref(),
+                    u.v,
+                    seed,
+                );
+                (u.v, u.varies, u.blockers) = (v, varies, Some(list));
+            }
+        }
+        verts
+            .iter()
+            .map(|&(_, v)| (v, self.at(v, leaf, chain, &unsure)))
+            .collect()
+    }
+
+    /// Irradiance at `p` (normal `n`) over the links of `chain`, with the visibilities of
+    /// `unsure` in place of their links', and for each of those its error by `err`
+    /// (given what its source gives `p` unhidden).
+    fn gathered_at(
+        &self,
+        p: DVec3,
+        n: DVec3,
+        chain: &[u32],
+        unsure: &[Unsure],
+        mut err: impl FnMut(&Unsure, DVec3) -> f64,
+    ) -> (DVec3, Vec<f64>) {
+        let (h, g) = (self.h, self.g);
+        let mut e = DVec3::ZERO;
+        let mut errs = Vec::with_capacity(unsure.len());
+        let mut next = 0;
+        for &a in chain {
+            for l in &g.links[self.links(g, a)] {
+                let s = &h.nodes[l.source as usize];
+                if !s.is_planar() {
+                    let (k, u) = point_coefficient(h, self.faces, self.el, p, n, s);
+                    e += self.solver.sent(self.b, l.source, u) * (k * l.v as f64);
+                    continue;
+                }
+                let x = self.unhidden(p, n, l.source);
+                if l.clear {
+                    e += x * l.v as f64;
+                } else {
+                    let u = &unsure[next];
+                    next += 1;
+                    e += x * u.v;
+                    errs.push(err(u, x));
+                }
+            }
+            for l in &self.hidden.links[self.links(self.hidden, a)] {
+                if h.nodes[l.source as usize].is_planar() {
+                    let u = &unsure[next];
+                    next += 1;
+                    // Unseen by the leaf: what the vertex could miss, from the coefficient.
+                    let x = if u.v > 0.0 || u.varies {
+                        self.unhidden(p, n, l.source)
+                    } else {
+                        DVec3::ZERO
+                    };
+                    e += x * u.v;
+                    errs.push(err(u, x));
+                }
+            }
+        }
+        (e, errs)
+    }
+
+    /// Irradiance at vertex `v` of `leaf` (ancestors `chain`), given the leaf's look at its
+    /// `unsure` links: the vertex looks itself at those the leaf found in part.
+    fn at(&self, v: u32, leaf: u32, chain: &[u32], unsure: &[Unsure]) -> DVec3 {
+        let (h, el) = (self.h, self.el);
         // A hair towards the leaf's centre: a vertex on a face's border lies in the plane
         // of the face beyond it, and takes the limit from inside its own face.
         let p = el
@@ -154,74 +292,55 @@ impl Gather<'_> {
             .unwrap_or(el.positions[v as usize]);
         let p = p + (h.nodes[leaf as usize].centroid - p) * 1e-6;
         let face = el.vertex_face[v as usize];
-        let n = faces[face as usize].plane.n;
-        let mut e = DVec3::ZERO;
-        // Planar sources whose visibility is a mean: (what the source would give the vertex
-        // unhidden if known yet, how far off the mean could leave the vertex, the mean, the
-        // source).
-        let mut unsure: Vec<(Option<DVec3>, f64, f64, u32)> = Vec::new();
-        let unhidden = |source: u32| {
-            let ns = faces[h.nodes[source as usize].face as usize].plane.n;
-            planar_gather(h, el, p, n, source, ns, bm)
-        };
-        for &a in chain {
-            for l in &g.links[of(g, a)] {
-                let s = &h.nodes[l.source as usize];
-                let lv = l.v as f64;
-                if !s.is_planar() {
-                    let (k, u) = point_coefficient(h, faces, el, p, n, s);
-                    e += self.solver.sent(self.b, l.source, u) * (k * lv);
-                    continue;
-                }
-                let x = unhidden(l.source);
-                e += x * lv;
-                if !l.clear {
-                    unsure.push((Some(x), x.element_sum() * lv.max(1.0 - lv), lv, l.source));
-                }
+        let n = self.faces[face as usize].plane.n;
+        let mut xs = Vec::with_capacity(unsure.len());
+        let (mut e, errs) = self.gathered_at(p, n, chain, unsure, |u, x| {
+            xs.push(x);
+            if u.varies {
+                x.element_sum() * u.v.max(1.0 - u.v)
+            } else {
+                0.0
             }
-            // A link whose few rays were all blocked is left out of the solve, but a vertex
-            // may see its source: links through slats that hide 60 % have all 4 rays blocked
-            // one time in eight, and vertices that took their own visibility for the other
-            // links only were 11 % too dark. What the source could give is taken from the
-            // link's coefficient until the vertex looks.
-            for l in &hidden.links[of(hidden, a)] {
-                if h.nodes[l.source as usize].is_planar() {
-                    let bound = (bm[l.source as usize] * l.k as f64).element_sum();
-                    unsure.push((None, bound, 0.0, l.source));
-                }
-            }
-        }
-        let mut left: f64 = unsure.iter().map(|u| u.1).sum();
+        });
         let allowed = self.tolerance * (e + self.direct[v as usize]).element_sum();
-        if left <= allowed {
-            return e;
-        }
-        // The most uncertain first (a stable sort: the same order on every thread).
-        unsure.sort_by(|x, y| y.1.total_cmp(&x.1));
-        for &(x, err, lv, s) in &unsure {
-            if left <= allowed {
-                break;
-            }
-            left -= err;
-            let node = &h.nodes[s as usize];
-            let listed = match shafts.of.iter().position(|(src, _)| *src == s) {
-                Some(i) => i,
-                None => {
-                    let leaf_node = &h.nodes[leaf as usize];
-                    shafts.of.push((s, self.vis.blockers(leaf_node, node)));
-                    shafts.of.len() - 1
-                }
-            };
-            let blockers = shafts.of[listed].1.as_deref();
-            let seed = mix(mix(v as u64) ^ s as u64);
-            let at = (p, n, face);
-            let own = own_visibility(self.vis, &self.table, at, node, blockers, lv, seed);
-            if own != lv {
-                e += x.unwrap_or_else(|| unhidden(s)) * (own - lv);
+        for i in by_error(&errs, allowed) {
+            let u = &unsure[i];
+            let s = &h.nodes[u.source as usize];
+            let list = u.blockers.as_ref().and_then(|b| b.as_deref());
+            let seed = mix(mix(v as u64) ^ u.source as u64);
+            let start = Start::Point(p, n, face);
+            let (own, _) = own_visibility(self.vis, &self.table, start, s, list, u.v, seed);
+            if own != u.v {
+                let x = if xs[i] == DVec3::ZERO {
+                    self.unhidden(p, n, u.source)
+                } else {
+                    xs[i]
+                };
+                e += x * (own - u.v);
             }
         }
         e
     }
+}
+
+/// Indices of `errs` from the largest down, as far as it takes for what is left to be
+/// under `allowed` (a stable sort: the same order on every thread).
+fn by_error(errs: &[f64], allowed: f64) -> Vec<usize> {
+    let mut left: f64 = errs.iter().sum();
+    if left <= allowed {
+        return Vec::new();
+    }
+    let mut order: Vec<usize> = (0..errs.len()).collect();
+    order.sort_by(|&a, &b| errs[b].total_cmp(&errs[a]));
+    let mut out = Vec::new();
+    for i in order {
+        if left <= allowed || errs[i] <= 0.0 {
+            break;
+        }
+        left -= errs[i];
+        out.push(i);
+    }
+    out
 }
 
 /// The visibility of node `s` from the point `at` = (position, normal, scene face) that the
@@ -241,36 +360,35 @@ impl Gather<'_> {
 fn own_visibility(
     vis: &Visibility,
     table: &AreaTable,
-    at: (DVec3, DVec3, u32),
+    start: Start,
     s: &Node,
     blockers: Option<&[u32]>,
     lv: f64,
     seed: u64,
-) -> f64 {
-    let (p, n, face) = at;
-    // Nothing between the leaf and the source: the vertex sees all of it.
+) -> (f64, bool) {
+    // Nothing between the leaf and the source: all of it is in sight.
     if blockers.is_some_and(|l| l.is_empty()) {
-        return 1.0;
+        return (1.0, false);
     }
+    let varies = |seen: &Seen| seen.open > 0.0 && seen.open < seen.total;
     let mut seen = Seen::default();
     let mut cast = 0;
     let mut k = REPLACE_RAYS;
     // A link whose rays all agreed (lv 0 or 1) is screened first by a few rays: if they all
-    // agree too, the vertex keeps the link's value.
-    let unanimous = lv == 0.0 || lv == 1.0;
-    if unanimous {
-        seen = seen_from(vis, table, (p, n, face), s, blockers, SCREEN_RAYS, seed);
+    // agree too, the link's value stands.
+    if lv == 0.0 || lv == 1.0 {
+        seen = seen_from(vis, table, start, s, blockers, SCREEN_RAYS, seed);
         cast = SCREEN_RAYS;
         match seen.fraction() {
             Some(v) if v != lv => k = REPLACE_RAYS - SCREEN_RAYS,
-            _ => return lv,
+            _ => return (lv, false),
         }
     }
     for round in 1u64.. {
         seen.add(seen_from(
             vis,
             table,
-            (p, n, face),
+            start,
             s,
             blockers,
             k,
@@ -278,7 +396,7 @@ fn own_visibility(
         ));
         cast += k;
         let Some(v) = seen.fraction() else {
-            return lv;
+            return (lv, false);
         };
         let d = (v - lv).abs();
         let var = (lv * (1.0 - lv)).max(v * (1.0 - v)) / seen.effective().max(1.0);
@@ -291,9 +409,9 @@ fn own_visibility(
         };
         if z <= NOISE || z >= SURE || cast >= MAX_VERTEX_RAYS {
             let t = ((z - NOISE) / (SURE - NOISE)).clamp(0.0, 1.0);
-            return lv + (v - lv) * t * t * (3.0 - 2.0 * t);
+            return (lv + (v - lv) * t * t * (3.0 - 2.0 * t), varies(&seen));
         }
         k = cast.min(MAX_VERTEX_RAYS - cast);
     }
-    lv
+    (lv, false)
 }
