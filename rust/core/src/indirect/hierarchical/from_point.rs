@@ -1,4 +1,4 @@
-//! How much of a node one point sees, by rays from the point to points of the node, for the
+//! How much of a node a point (or a leaf) sees, by rays to points of the node, for the
 //! final gather at element vertices (`vertices`).
 //!
 //! The points are stratified over the node's area: its leaf positions are laid end to end
@@ -6,16 +6,18 @@
 //! one point, jittered within it by a hash of the (vertex, source, stratum); the part of a
 //! triangle's interval the point falls in is one coordinate of the point in the triangle
 //! and a second hash the other, through the area-preserving square-to-triangle map. So
-//! every point is uniform over the node's area, and the strata spread them over it.
+//! every point is uniform over the node's area, and the strata spread them over it. From a
+//! leaf, the start points are drawn the same way, their strata in another order.
 //!
 //! The estimate is the ratio of the point-to-point kernel `cosθ·cosθs / d²` over the open
-//! segments to the kernel over all of them. Each segment's openness depends on where a
-//! blocker stands, its kernel on where the point is: with the points drawn independently of
-//! the blockers the ratio's expectation is the kernel-weighted visible fraction whatever the
-//! sample count, wherever the two are not correlated, and its bias where they are is of order
-//! the spread of the weights over the count. A lattice of points or a chain of hashes from
-//! consecutive seeds falls in step with a regular blocker (slats): the lead's first try put
-//! 8 rays through slats that hide 60 % at 0.48–0.62 seen.
+//! segments to the kernel over all of them. Where a segment is open depends on where the
+//! blockers stand, its kernel on where its end is: with the points drawn independently of
+//! the blockers the ratio's expectation is the kernel-weighted visible fraction for any
+//! count, and where the two are correlated its bias is of the order of the weights' spread
+//! over the count. Measured through slats that hide 60 %, 16 rays from one vertex to each
+//! of its links' sources, 400 draws each: means within 0.01 of 4096 rays'. A lattice of
+//! points, or hashes chained from consecutive seeds, falls in step with a regular blocker:
+//! 8 such rays from one vertex through the same slats saw 0.48–0.62 of the emitter, not 0.40.
 
 use glam::DVec3;
 

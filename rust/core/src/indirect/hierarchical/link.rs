@@ -87,7 +87,9 @@ impl<'a> Ends<'a> {
         a * cr * cs / (std::f64::consts::PI * d2 + a)
     }
 
-    /// The link with visibility `v` (fraction of the source seen from the receiver).
+    /// The link with visibility `v` (fraction of the source seen from the receiver), and
+    /// `clear` when nothing lies in the shaft between the two.
+    #[allow(clippy::too_many_arguments)]
     pub fn link(
         &self,
         h: &Hierarchy,
