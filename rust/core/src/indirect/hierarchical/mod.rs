@@ -12,7 +12,8 @@
 //! a fixed set of rays for the partly blocked (`visibility`). Jacobi sweeps with push–pull
 //! (`solve`) run until a sweep adds less than `convergence` of the emitted power, and each
 //! element vertex gathers once more over the links above it, with factors from the vertex
-//! itself (`vertices`). Every step gives the same bits
+//! itself and, where a link's shaft is not clear, visibility from its leaf or itself
+//! (`vertices`). Every step gives the same bits
 //! for any thread count.
 //!
 //! Parts of faces lying against another face (`covered`) neither shoot nor receive. The
@@ -61,8 +62,8 @@ const LEAF_RADIUS: f64 = 0.25;
 /// Links allowed per leaf (plus `LINK_FLOOR`) before the bake is refused: bounds memory.
 const LINKS_PER_LEAF: u64 = 400;
 const LINK_FLOOR: u64 = 1 << 22;
-/// A vertex leaves to its links' mean visibilities at most this times `convergence` of its
-/// light (`vertices`).
+/// A leaf, then a vertex, leaves to its links' mean visibilities at most this times
+/// `convergence` of its light (`vertices`).
 const VISIBILITY_SCALE: f64 = 100.0;
 /// Cap on sweeps whatever `max_shots` says.
 const MAX_SWEEPS: u64 = 1000;
@@ -116,14 +117,13 @@ pub fn indirect(
     let b_max = radiosity_bounds(&h, &leaves, emitted_power);
     let b_range = first_radiosity_range(&h, &leaves);
     let max_links = LINKS_PER_LEAF * nl as u64 + LINK_FLOOR;
-    let vis = Visibility {
-        h: &h,
-        faces,
-        el,
-        occ,
-    };
     let refiner = Refiner::new(
-        vis,
+        Visibility {
+            h: &h,
+            faces,
+            el,
+            occ,
+        },
         &b_max,
         &b_range,
         EPS_SCALE * settings.convergence * emitted_power,

@@ -559,11 +559,6 @@ fn many_occluders_go_through_the_bvh() {
     }
     assert!(ratios.iter().all(|r| (r - 0.4).abs() < 0.1), "{ratios:?}");
     let mean = ratios.iter().sum::<f64>() / ratios.len() as f64;
-    eprintln!(
-        "slats: mean {mean} min {} max {}",
-        ratios.iter().cloned().fold(9.0, f64::min),
-        ratios.iter().cloned().fold(0.0, f64::max)
-    );
     assert!((mean - 0.4).abs() < 0.03, "{mean}");
 }
 
