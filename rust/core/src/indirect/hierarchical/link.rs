@@ -30,12 +30,16 @@ pub const EXACT_LEAVES: u32 = 8;
 pub struct Link {
     pub receiver: u32,
     pub source: u32,
-    /// Coefficient, visibility included (see the module doc for each kind).
+    /// Coefficient, visibility included (see the module doc for each kind); for a link
+    /// whose rays were all blocked (`v` = 0, left out of the solve), without it.
     pub k: f32,
     /// Unit direction from the receiver's centroid to the source's.
     pub u: Vec3,
     /// Fraction of the source seen from the receiver.
     pub v: f32,
+    /// The shaft between the two holds nothing: every point of the receiver sees all of
+    /// the source. Otherwise `v` is a mean, and a point may see more or less (`vertices`).
+    pub clear: bool,
 }
 
 /// What a link needs to know of its two ends.
@@ -83,7 +87,9 @@ impl<'a> Ends<'a> {
         a * cr * cs / (std::f64::consts::PI * d2 + a)
     }
 
-    /// The link with visibility `v` (fraction of the source seen from the receiver).
+    /// The link with visibility `v` (fraction of the source seen from the receiver), and
+    /// `clear` when nothing lies in the shaft between the two.
+    #[allow(clippy::too_many_arguments)]
     pub fn link(
         &self,
         h: &Hierarchy,
@@ -91,6 +97,7 @@ impl<'a> Ends<'a> {
         receiver: u32,
         source: u32,
         v: f64,
+        clear: bool,
         sample: bool,
     ) -> Link {
         let pi = std::f64::consts::PI;
@@ -136,6 +143,7 @@ impl<'a> Ends<'a> {
             k: (k * v) as f32,
             u: u.as_vec3(),
             v: v as f32,
+            clear,
         }
     }
 }
@@ -258,13 +266,13 @@ mod test {
         let faces = [bottom, top];
         let (h, el, r, s) = face_nodes(&faces);
         let ends = Ends::new(&h, &faces, r, s);
-        let l = ends.link(&h, &el, r, s, 1.0, true);
+        let l = ends.link(&h, &el, r, s, 1.0, true, true);
         // Exact: a point under a small square's centre: F ≈ A/(π·h²).
         let want = 0.01 / (std::f64::consts::PI * 4.0);
         assert!((l.k as f64 / want - 1.0).abs() < 2e-3, "{} vs {want}", l.k);
         assert!(ends.factor_bound() >= l.k as f64 * 0.999);
         // Half visible: half the coefficient.
-        let half = ends.link(&h, &el, r, s, 0.5, true);
+        let half = ends.link(&h, &el, r, s, 0.5, false, true);
         assert!((half.k * 2.0 - l.k).abs() < 1e-9);
         assert!((l.u - Vec3::Z).length() < 1e-6);
     }
@@ -335,7 +343,7 @@ mod test {
         let (h, el, r, s) = face_nodes(&faces);
         assert!(!h.nodes[r as usize].is_leaf() && !h.nodes[s as usize].is_leaf());
         let ends = Ends::new(&h, &faces, r, s);
-        let k = ends.link(&h, &el, r, s, 1.0, false).k;
+        let k = ends.link(&h, &el, r, s, 1.0, true, false).k;
         // From the receiver's centre the other plate fills nearly all the hemisphere.
         assert!(k > 0.98 && k <= 1.0, "{k}");
     }

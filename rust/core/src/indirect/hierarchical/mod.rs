@@ -12,7 +12,8 @@
 //! a fixed set of rays for the partly blocked (`visibility`). Jacobi sweeps with push–pull
 //! (`solve`) run until a sweep adds less than `convergence` of the emitted power, and each
 //! element vertex gathers once more over the links above it, with factors from the vertex
-//! itself (`vertices`). Every step gives the same bits
+//! itself and, where a link's shaft is not clear, visibility from its leaf or itself
+//! (`vertices`). Every step gives the same bits
 //! for any thread count.
 //!
 //! Parts of faces lying against another face (`covered`) neither shoot nor receive. The
@@ -24,6 +25,7 @@
 //! sweeps; `patch_size` is not used (the hierarchy replaces the grid patches).
 
 mod back;
+mod from_point;
 mod hierarchy;
 mod link;
 mod refine;
@@ -60,6 +62,9 @@ const LEAF_RADIUS: f64 = 0.25;
 /// Links allowed per leaf (plus `LINK_FLOOR`) before the bake is refused: bounds memory.
 const LINKS_PER_LEAF: u64 = 400;
 const LINK_FLOOR: u64 = 1 << 22;
+/// A leaf, then a vertex, leaves to its links' mean visibilities at most this times
+/// `convergence` of its light (`vertices`).
+const VISIBILITY_SCALE: f64 = 100.0;
 /// Cap on sweeps whatever `max_shots` says.
 const MAX_SWEEPS: u64 = 1000;
 
@@ -138,11 +143,16 @@ pub fn indirect(
             ),
         ));
     }
-    result.links = refined.links.len() as u64;
+    // Pairs whose rays were all blocked carry nothing in the solve; only the final gather
+    // at the vertices looks at them again.
+    let (links, hidden): (Vec<_>, Vec<_>) = refined.links.into_iter().partition(|l| l.v > 0.0);
+    result.links = links.len() as u64;
     result.rays = refined.rays;
-    let g = Gathering::new(refined.links, h.nodes.len());
+    let g = Gathering::new(links, h.nodes.len());
+    let hidden = Gathering::new(hidden, h.nodes.len());
     result.bytes_per_leaf = h.bytes_per_leaf()
-        + (g.links.len() * std::mem::size_of::<link::Link>() + g.start.len() * 4) as f64
+        + ((g.links.len() + hidden.links.len()) * std::mem::size_of::<link::Link>()
+            + (g.start.len() + hidden.start.len()) * 4) as f64
             / nl.max(1) as f64;
 
     progress.set_fraction(0.0);
@@ -159,7 +169,24 @@ pub fn indirect(
     result.unshot_fraction = sol.last_change;
     progress.check()?;
     let b = sol.radiosity.as_ref().expect("the solve pulls at its end");
-    let mut at = vertices::gathered(&h, faces, el, &g, &solver, b);
+    let vis = Visibility {
+        h: &h,
+        faces,
+        el,
+        occ,
+    };
+    let mut at = vertices::gathered(
+        &h,
+        faces,
+        el,
+        &g,
+        &hidden,
+        &solver,
+        b,
+        &vis,
+        direct,
+        VISIBILITY_SCALE * settings.convergence,
+    );
     if settings.ambient {
         let amb = ambient(&h, &leaves, sol.last_delta);
         at.iter_mut().for_each(|e| *e += amb);

@@ -257,8 +257,17 @@ impl<'a> Refiner<'a> {
             };
         }
         self.settle(rn, sn);
-        if v > 0.0 {
-            let link = ends.link(h, self.vis.el, r, s, v, !faint);
+        // A pair whose rays were all blocked is kept with v = 0 and its coefficient unhidden:
+        // the solve leaves it out, but a vertex may find part of its source in sight
+        // (`vertices`).
+        if v > 0.0 || cast > 0 {
+            let clear = blockers.as_ref().is_some_and(|l| l.is_empty());
+            let mut link = if v > 0.0 {
+                ends.link(h, self.vis.el, r, s, v, clear, !faint)
+            } else {
+                ends.link(h, self.vis.el, r, s, 1.0, clear, false)
+            };
+            link.v = v as f32;
             if link.k > 0.0 || ends.factor_bound() > 0.0 {
                 out.push(link);
                 let n = self.links.fetch_add(1, Ordering::Relaxed) + 1;

@@ -1,0 +1,198 @@
+//! How much of a node a point (or a leaf) sees, by rays to points of the node, for the
+//! final gather at element vertices (`vertices`).
+//!
+//! The points are stratified over the node's area: its leaf positions are laid end to end
+//! by area (`AreaTable`), the unit interval is cut into `k` strata, and each stratum takes
+//! one point, jittered within it by a hash of the (vertex, source, stratum); the part of a
+//! triangle's interval the point falls in is one coordinate of the point in the triangle
+//! and a second hash the other, through the area-preserving square-to-triangle map. So
+//! every point is uniform over the node's area, and the strata spread them over it. From a
+//! leaf, the start points are drawn the same way, their strata in another order.
+//!
+//! The estimate is the ratio of the point-to-point kernel `cosθ·cosθs / d²` over the open
+//! segments to the kernel over all of them. Where a segment is open depends on where the
+//! blockers stand, its kernel on where its end is: with the points drawn independently of
+//! the blockers the ratio's expectation is the kernel-weighted visible fraction for any
+//! count, and where the two are correlated its bias is of the order of the weights' spread
+//! over the count. Measured through slats that hide 60 %, 16 rays from one vertex to each
+//! of its links' sources, 400 draws each: means within 0.01 of 4096 rays'. A lattice of
+//! points, or hashes chained from consecutive seeds, falls in step with a regular blocker:
+//! 8 such rays from one vertex through the same slats saw 0.48–0.62 of the emitter, not 0.40.
+
+use glam::DVec3;
+
+use super::hierarchy::{Hierarchy, Node};
+use super::visibility::Visibility;
+
+/// Blocker lists longer than this go to the BVH per segment instead.
+const MAX_LISTED: usize = 32;
+
+/// Cumulative area of the leaf positions (`Hierarchy::order`): position `p` spans
+/// `cum[p]..cum[p + 1]`, and a node's range `lo..hi` spans `cum[lo]..cum[hi]`.
+pub struct AreaTable {
+    cum: Vec<f64>,
+}
+
+impl AreaTable {
+    pub fn new(h: &Hierarchy) -> Self {
+        let mut cum = Vec::with_capacity(h.area.len() + 1);
+        let mut a = 0.0;
+        cum.push(0.0);
+        for &x in &h.area {
+            a += x.max(0.0);
+            cum.push(a);
+        }
+        AreaTable { cum }
+    }
+
+    /// The leaf position of node `n` at the fraction `u` of its area, and the fraction of
+    /// that position's own area that `u` falls at.
+    fn at(&self, n: &Node, u: f64) -> (u32, f64) {
+        let (lo, hi) = (n.lo as usize, n.hi as usize);
+        let (a, b) = (self.cum[lo], self.cum[hi]);
+        let x = a + u * (b - a);
+        // Last position whose start is at or below x, within the node's range.
+        let pos = lo + self.cum[lo + 1..hi].partition_point(|&c| c <= x);
+        let (s, e) = (self.cum[pos], self.cum[pos + 1]);
+        let t = if e > s { (x - s) / (e - s) } else { 0.5 };
+        (pos as u32, t.clamp(0.0, 1.0 - 1e-12))
+    }
+}
+
+/// Sums of a run of rays from a point to a node: kernel over the open segments and over
+/// all, the sum of squared kernels (for the effective count) and the rays cast.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Seen {
+    pub open: f64,
+    pub total: f64,
+    pub total_sq: f64,
+    pub rays: u32,
+}
+
+impl Seen {
+    /// Kernel-weighted fraction of the node seen; `None` when no point of it faced the
+    /// point.
+    pub fn fraction(&self) -> Option<f64> {
+        (self.total > 0.0).then(|| (self.open / self.total).clamp(0.0, 1.0))
+    }
+
+    /// The count of equally weighted samples as informative as these: (Σw)² / Σw².
+    pub fn effective(&self) -> f64 {
+        if self.total_sq > 0.0 {
+            self.total * self.total / self.total_sq
+        } else {
+            0.0
+        }
+    }
+
+    pub fn add(&mut self, o: Seen) {
+        self.open += o.open;
+        self.total += o.total;
+        self.total_sq += o.total_sq;
+        self.rays += o.rays;
+    }
+}
+
+/// Where segments start: one point (position, normal, scene face), or stratified points of
+/// a planar node.
+#[derive(Clone, Copy)]
+pub enum Start<'a> {
+    Point(DVec3, DVec3, u32),
+    Node(&'a Node),
+}
+
+/// `k` stratified segments from `start` to node `s`, drawn from the stream `seed` (a
+/// different seed gives independent strata). `blockers` holds every face that could cross
+/// one (`Visibility::blockers`), or `None` for the BVH.
+pub fn seen_from(
+    vis: &Visibility,
+    table: &AreaTable,
+    start: Start,
+    s: &Node,
+    blockers: Option<&[u32]>,
+    k: u32,
+    seed: u64,
+) -> Seen {
+    let h = vis.h;
+    let face = match start {
+        Start::Point(_, _, f) => f,
+        Start::Node(r) => h.real_face(r.face),
+    };
+    let mut skip = [face, face];
+    if s.is_planar() {
+        skip[1] = h.real_face(s.face);
+    }
+    let mut out = Seen::default();
+    if s.hi <= s.lo || matches!(start, Start::Node(r) if r.hi <= r.lo) {
+        return out;
+    }
+    let k = k.max(1);
+    for i in 0..k {
+        let r = mix(seed ^ mix(i as u64 + 1));
+        let (y, ny) = point_of(vis, table, s, (i as f64 + unit(r)) / k as f64, unit(mix(r)));
+        let (p, n) = match start {
+            Start::Point(p, n, _) => (p, n),
+            // The start's strata in another order (7 is prime to the powers of two the
+            // counts are), so that the pairs do not run side by side across the two nodes.
+            Start::Node(rn) => {
+                let j = (i as u64 * 7 + 3) % k as u64;
+                let q = mix(r ^ 0x5851_f42d_4c95_7f2d);
+                point_of(
+                    vis,
+                    table,
+                    rn,
+                    (j as f64 + unit(q)) / k as f64,
+                    unit(mix(q)),
+                )
+            }
+        };
+        let d = y - p;
+        let (ca, cb) = (n.dot(d), -ny.dot(d));
+        if !(ca > 0.0 && cb > 0.0) {
+            continue;
+        }
+        let d2 = d.length_squared();
+        let w = ca * cb / (d2 * d2);
+        if !w.is_finite() {
+            continue;
+        }
+        out.total += w;
+        out.total_sq += w * w;
+        out.rays += 1;
+        let blocked = match blockers {
+            Some(l) if l.len() <= MAX_LISTED => vis.occ.segment_blocked_by(p, y, l),
+            _ => vis.occ.segment_blocked_skip(p, y, &skip),
+        };
+        if !blocked {
+            out.open += w;
+        }
+    }
+    out
+}
+
+/// The point of node `n` at the fraction `u` of its area (`AreaTable`), the part of its
+/// triangle's share that `u` falls at and `v` its coordinates in the triangle, with its
+/// leaf's normal (a back leaf faces the other way from its triangle).
+fn point_of(vis: &Visibility, table: &AreaTable, n: &Node, u: f64, v: f64) -> (DVec3, DVec3) {
+    let h = vis.h;
+    let (pos, t) = table.at(n, u);
+    let tri = h.order[pos as usize] as usize;
+    let [a, b, c] = vis.el.triangles[tri].map(|i| vis.el.positions[i as usize]);
+    let st = t.sqrt();
+    let y = a * (1.0 - st) + b * (st * (1.0 - v)) + c * (st * v);
+    let leaf_face = h.nodes[h.leaf_node[pos as usize] as usize].face;
+    (y, vis.faces[leaf_face as usize].plane.n)
+}
+
+/// splitmix64's finaliser: a well-mixed 64-bit hash.
+pub fn mix(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+/// The top 53 bits of `r` as a number in [0, 1).
+fn unit(r: u64) -> f64 {
+    (r >> 11) as f64 / (1u64 << 53) as f64
+}
