@@ -22,10 +22,7 @@
 use glam::DVec3;
 
 use super::hierarchy::{Hierarchy, Node};
-use super::visibility::Visibility;
-
-/// Blocker lists longer than this go to the BVH per segment instead.
-const MAX_LISTED: usize = 32;
+use super::visibility::{Visibility, MAX_LISTED};
 
 /// Cumulative area of the leaf positions (`Hierarchy::order`): position `p` spans
 /// `cum[p]..cum[p + 1]`, and a node's range `lo..hi` spans `cum[lo]..cum[hi]`.

@@ -13,7 +13,7 @@ use crate::mesh::elements::Elements;
 use crate::scene::Face;
 
 /// Blocker lists longer than this go to the BVH per segment instead.
-const MAX_LISTED: usize = 32;
+pub const MAX_LISTED: usize = 32;
 /// Shaft tests give up (and rays go through the BVH) past this many candidate faces: for
 /// large nodes in clutter, sifting every face in the box costs more than a few rays.
 const MAX_CANDIDATES: usize = 64;
