@@ -6,6 +6,7 @@ pub mod box_grid;
 pub mod bvh;
 pub mod edge_soup;
 pub mod frame;
+pub mod hash;
 pub mod lambert;
 pub mod plane;
 pub mod polygon;

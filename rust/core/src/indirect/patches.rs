@@ -7,6 +7,7 @@
 
 use glam::{DVec2, DVec3};
 
+use crate::geom::hash::{mix, unit};
 use crate::geom::polygon::{
     clip_polygon_2d, signed_area_2d, simplify_convex, strictly_inside_convex, HalfPlane,
 };
@@ -427,18 +428,6 @@ fn stratified(poly: &[DVec2], centroid: DVec2, n: u32, seed: u64) -> Vec<DVec2> 
         return inside;
     }
     (0..n).map(|k| inside[k * inside.len() / n]).collect()
-}
-
-/// SplitMix64's finaliser: a cheap, well-spread hash.
-fn mix(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
-}
-
-fn unit(h: u64) -> f64 {
-    (h >> 11) as f64 / (1u64 << 53) as f64
 }
 
 #[cfg(test)]

@@ -23,6 +23,7 @@ use glam::DVec3;
 
 use super::hierarchy::{Hierarchy, Node};
 use super::visibility::{Visibility, MAX_LISTED};
+use crate::geom::hash::{mix, unit};
 
 /// Cumulative area of the leaf positions (`Hierarchy::order`): position `p` spans
 /// `cum[p]..cum[p + 1]`, and a node's range `lo..hi` spans `cum[lo]..cum[hi]`.
@@ -179,17 +180,4 @@ fn point_of(vis: &Visibility, table: &AreaTable, n: &Node, u: f64, v: f64) -> (D
     let y = a * (1.0 - st) + b * (st * (1.0 - v)) + c * (st * v);
     let leaf_face = h.nodes[h.leaf_node[pos as usize] as usize].face;
     (y, vis.faces[leaf_face as usize].plane.n)
-}
-
-/// splitmix64's finaliser: a well-mixed 64-bit hash.
-pub fn mix(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
-}
-
-/// The top 53 bits of `r` as a number in [0, 1).
-fn unit(r: u64) -> f64 {
-    (r >> 11) as f64 / (1u64 << 53) as f64
 }

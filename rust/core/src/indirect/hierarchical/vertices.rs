@@ -30,11 +30,12 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::from_point::{mix, seen_from, AreaTable, Seen, Start};
+use super::from_point::{seen_from, AreaTable, Seen, Start};
 use super::hierarchy::{Hierarchy, Node, NONE};
 use super::link::{planar_gather, point_coefficient};
 use super::solve::{Gathering, Radiosity, Solver};
 use super::visibility::Visibility;
+use crate::geom::hash::mix;
 use crate::mesh::elements::Elements;
 use crate::scene::Face;
 
