@@ -277,6 +277,30 @@ pub(super) fn check_faces(
             }
         }
     }
+    // A failing element is also cut across its longest edge (Rivara's bisection), which
+    // its samples may pass: a midpoint can fall where the light's curve along the edge
+    // crosses its chord. Cut only at what failed, an element along such an edge gets
+    // flatter each pass, its apex halving its way down to the edge (clutter at high: strips
+    // 1e-7 high and 2 mm long along a box's contact line, 6.2× the tolerance).
+    for (i, &f) in check.iter().enumerate() {
+        if !failed[i] {
+            continue;
+        }
+        let p = tris[i];
+        let k = (0..3)
+            .max_by(|&a, &b| {
+                (p[a] - p[(a + 1) % 3])
+                    .length_squared()
+                    .total_cmp(&(p[b] - p[(b + 1) % 3]).length_squared())
+            })
+            .expect("three edges");
+        if (p[k] - p[(k + 1) % 3]).length() < 2.0 * lower {
+            continue;
+        }
+        let vs = view.vertices(f);
+        let (a, b) = (vs[k], vs[(k + 1) % 3]);
+        edges.push((a.min(b), a.max(b)));
+    }
     Ok((!edges.is_empty() || !centroids.is_empty()).then_some((edges, centroids)))
 }
 

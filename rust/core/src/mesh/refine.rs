@@ -2,7 +2,8 @@
 //! light is cheap to evaluate anywhere (closed form where lit, the visible part of the light
 //! in penumbra, nothing in umbra), so after the conforming CDT each element is checked where
 //! linear interpolation errs most, at its edge midpoints and its centroid, and split where
-//! |interpolated − exact| > tolerance × (exact + floor). The floor, a fraction of the
+//! |interpolated − exact| > tolerance × (exact + floor), there and across its longest edge
+//! (`check`: bisection keeps elements from flattening towards an edge). The floor, a fraction of the
 //! receiver's brightest value, keeps dark regions from refining without end. Splits insert
 //! points into the CDT, which keeps the D1/D0 constraint edges (a constraint edge is split
 //! into two constraint halves) and the Delaunay property (spade re-legalises around each new
