@@ -151,8 +151,11 @@ impl Occluders {
         let Some(ray) = self.bvh_ray(a, d / len, len) else {
             return false;
         };
-        !bvh.ray_traverse_miss(ray, |_, i| {
+        !bvh.ray_traverse_miss(ray, |ray, i| {
             let id = bvh.primitive_indices[i];
+            if !self.ray_meets_box(ray, id) {
+                return f32::INFINITY;
+            }
             if !skip.contains(&id) && self.face_crosses_segment(id, a, b) {
                 0.0
             } else {
@@ -198,8 +201,11 @@ impl Occluders {
         let Some(ray) = self.bvh_ray(origin, dir, f64::INFINITY) else {
             return false;
         };
-        !bvh.ray_traverse_miss(ray, |_, i| {
+        !bvh.ray_traverse_miss(ray, |ray, i| {
             let id = bvh.primitive_indices[i];
+            if !self.ray_meets_box(ray, id) {
+                return f32::INFINITY;
+            }
             if !skip.contains(&id) && self.face_crosses_ray(id, origin, dir) {
                 0.0
             } else {
@@ -319,6 +325,14 @@ impl Occluders {
         let r = f.plane.n.abs().dot((hi - lo) * 0.5 + self.pad);
         let (b_lo, b_hi) = (c - r, c + r);
         (a_hi > self.tol && b_lo < -self.tol) || (a_lo < -self.tol && b_hi > self.tol)
+    }
+
+    /// Whether the `f32` ray meets face `id`'s padded box, by the test the traversal applies
+    /// to the BVH's nodes (so it never drops a face the node test would keep). A leaf holds
+    /// up to 8 faces; on room-245's final gather this skipped 5 of every 6 exact tests.
+    #[inline]
+    fn ray_meets_box(&self, ray: &Ray, id: u32) -> bool {
+        self.boxes[id as usize].intersect_ray(ray) < ray.tmax
     }
 
     fn face_crosses_segment(&self, id: u32, a: DVec3, b: DVec3) -> bool {
