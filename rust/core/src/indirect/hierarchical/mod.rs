@@ -146,15 +146,15 @@ pub fn indirect(
             ),
         ));
     }
-    // Pairs whose rays were all blocked carry nothing in the solve; only the final gather
-    // at the vertices looks at them again.
-    let (links, hidden): (Vec<_>, Vec<_>) = refined.links.into_iter().partition(|l| l.v > 0.0);
-    result.links = links.len() as u64;
+    // Pairs whose rays were all blocked (`refined.hidden`) carry nothing in the solve; only
+    // the final gather at the vertices looks at them again.
+    result.links = refined.links.len() as u64;
     result.rays = refined.rays;
-    let g = Gathering::new(links, h.nodes.len());
-    let hidden = Gathering::new(hidden, h.nodes.len());
+    let g = Gathering::new(refined.links, h.nodes.len());
+    let hidden = Gathering::new(refined.hidden, h.nodes.len());
     result.bytes_per_leaf = h.bytes_per_leaf()
-        + ((g.links.len() + hidden.links.len()) * std::mem::size_of::<link::Link>()
+        + (g.links.len() * std::mem::size_of::<link::Link>()
+            + hidden.links.len() * std::mem::size_of::<link::Hidden>()
             + (g.start.len() + hidden.start.len()) * 4) as f64
             / nl.max(1) as f64;
 

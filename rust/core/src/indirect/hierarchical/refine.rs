@@ -18,7 +18,7 @@
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use super::hierarchy::Node;
-use super::link::{Ends, Link};
+use super::link::{Ends, Hidden, Link};
 use super::visibility::Visibility;
 use crate::progress::Progress;
 
@@ -69,6 +69,8 @@ pub struct Refiner<'a> {
 
 pub struct Refined {
     pub links: Vec<Link>,
+    /// Pairs from planar sources whose rays were all blocked, for the final gather.
+    pub hidden: Vec<Hidden>,
     pub rays: u64,
     /// The link budget ran out (`max_links`).
     pub over_budget: bool,
@@ -103,12 +105,13 @@ impl<'a> Refiner<'a> {
 
     /// All links, from the root's link to itself.
     pub fn run(&self) -> Refined {
-        let mut links = Vec::new();
+        let mut out = Out::default();
         if !self.vis.h.nodes.is_empty() {
-            self.refine(0, 0, None, &mut links);
+            self.refine(0, 0, None, &mut out);
         }
         Refined {
-            links,
+            links: out.links,
+            hidden: out.hidden,
             rays: self.rays_cast.load(Ordering::Relaxed),
             over_budget: self.links.load(Ordering::Relaxed) > self.max_links,
         }
@@ -135,7 +138,7 @@ impl<'a> Refiner<'a> {
         }
     }
 
-    fn refine(&self, r: u32, s: u32, inherited: Option<&[u32]>, out: &mut Vec<Link>) {
+    fn refine(&self, r: u32, s: u32, inherited: Option<&[u32]>, out: &mut Out) {
         if self.stop.load(Ordering::Relaxed) {
             return;
         }
@@ -257,10 +260,11 @@ impl<'a> Refiner<'a> {
             };
         }
         self.settle(rn, sn);
-        // A pair whose rays were all blocked is kept with v = 0 and its coefficient unhidden:
+        // A pair whose rays were all blocked is kept apart with its coefficient unhidden:
         // the solve leaves it out, but a vertex may find part of its source in sight
-        // (`vertices`).
-        if v > 0.0 || cast > 0 {
+        // (`vertices`; only planar sources, as a vertex keeps a cluster's mean).
+        let hidden = v == 0.0 && cast > 0;
+        if v > 0.0 || (hidden && sn.is_planar()) {
             let clear = blockers.as_ref().is_some_and(|l| l.is_empty());
             let mut link = if v > 0.0 {
                 ends.link(h, self.vis.el, r, s, v, clear, !faint)
@@ -269,7 +273,15 @@ impl<'a> Refiner<'a> {
             };
             link.v = v as f32;
             if link.k > 0.0 || ends.factor_bound() > 0.0 {
-                out.push(link);
+                if hidden {
+                    out.hidden.push(Hidden {
+                        receiver: r,
+                        source: s,
+                        k: link.k,
+                    });
+                } else {
+                    out.links.push(link);
+                }
                 let n = self.links.fetch_add(1, Ordering::Relaxed) + 1;
                 if n % 4096 == 0 {
                     let done = f64::from_bits(self.settled.load(Ordering::Relaxed));
@@ -290,7 +302,7 @@ impl<'a> Refiner<'a> {
         over
     }
 
-    fn split_larger(&self, r: u32, s: u32, inherited: Option<&[u32]>, out: &mut Vec<Link>) {
+    fn split_larger(&self, r: u32, s: u32, inherited: Option<&[u32]>, out: &mut Out) {
         let (rn, sn) = (self.node(r), self.node(s));
         let split_r = !rn.is_leaf() && (sn.is_leaf() || rn.area >= sn.area);
         if split_r {
@@ -303,7 +315,7 @@ impl<'a> Refiner<'a> {
     }
 
     /// Refines `pairs` into `out` in their order, in parallel when they are large.
-    fn split(&self, pairs: &[(u32, u32)], inherited: Option<&[u32]>, out: &mut Vec<Link>) {
+    fn split(&self, pairs: &[(u32, u32)], inherited: Option<&[u32]>, out: &mut Out) {
         let size = |&(r, s): &(u32, u32)| {
             let (a, b) = (self.node(r), self.node(s));
             (a.hi - a.lo) as u64 * (b.hi - b.lo) as u64
@@ -315,19 +327,28 @@ impl<'a> Refiner<'a> {
             return;
         }
         let (a, b) = pairs.split_at(pairs.len() / 2);
-        let (mut la, lb) = rayon::join(
+        let (la, lb) = rayon::join(
             || {
-                let mut v = Vec::new();
+                let mut v = Out::default();
                 self.split(a, inherited, &mut v);
                 v
             },
             || {
-                let mut v = Vec::new();
+                let mut v = Out::default();
                 self.split(b, inherited, &mut v);
                 v
             },
         );
-        out.append(&mut la);
-        out.extend(lb);
+        for part in [la, lb] {
+            out.links.extend(part.links);
+            out.hidden.extend(part.hidden);
+        }
     }
+}
+
+/// What a refinement (or one branch of it) made, in refinement order.
+#[derive(Default)]
+pub struct Out {
+    links: Vec<Link>,
+    hidden: Vec<Hidden>,
 }

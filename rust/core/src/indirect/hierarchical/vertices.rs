@@ -32,7 +32,7 @@ use rayon::prelude::*;
 
 use super::from_point::{seen_from, AreaTable, Seen, Start};
 use super::hierarchy::{Hierarchy, Node, NONE};
-use super::link::{planar_gather, point_coefficient};
+use super::link::{planar_gather, point_coefficient, Hidden};
 use super::solve::{Gathering, Radiosity, Solver};
 use super::visibility::Visibility;
 use crate::geom::hash::mix;
@@ -62,7 +62,7 @@ pub fn gathered(
     faces: &[Face],
     el: &Elements,
     g: &Gathering,
-    hidden: &Gathering,
+    hidden: &Gathering<Hidden>,
     solver: &Solver,
     b: &Radiosity,
     vis: &Visibility,
@@ -134,7 +134,7 @@ struct Gather<'a> {
     faces: &'a [Face],
     el: &'a Elements,
     g: &'a Gathering,
-    hidden: &'a Gathering,
+    hidden: &'a Gathering<Hidden>,
     solver: &'a Solver<'a>,
     b: &'a Radiosity,
     vis: &'a Visibility<'a>,
@@ -158,7 +158,7 @@ struct Unsure {
 }
 
 impl Gather<'_> {
-    fn links(&self, g: &'_ Gathering, a: u32) -> std::ops::Range<usize> {
+    fn links<L>(&self, g: &Gathering<L>, a: u32) -> std::ops::Range<usize> {
         g.start[a as usize] as usize..g.start[a as usize + 1] as usize
     }
 
@@ -192,16 +192,15 @@ impl Gather<'_> {
             // may see its source: links through slats that hide 60 % have all 4 rays blocked
             // one time in eight, and vertices that took their own visibility for the other
             // links only were 11 % too dark.
+            // (Their sources are all planar: `refine` keeps no other.)
             for l in &hidden.links[self.links(hidden, a)] {
-                if h.nodes[l.source as usize].is_planar() {
-                    unsure.push(Unsure {
-                        source: l.source,
-                        v: 0.0,
-                        varies: false,
-                        blockers: None,
-                        hidden_k: l.k as f64,
-                    });
-                }
+                unsure.push(Unsure {
+                    source: l.source,
+                    v: 0.0,
+                    varies: false,
+                    blockers: None,
+                    hidden_k: l.k as f64,
+                });
             }
         }
         // The leaf's look, at its centroid's values: the largest errors first, until what
@@ -286,18 +285,16 @@ impl Gather<'_> {
                 }
             }
             for l in &self.hidden.links[self.links(self.hidden, a)] {
-                if h.nodes[l.source as usize].is_planar() {
-                    let u = &unsure[next];
-                    next += 1;
-                    // Unseen by the leaf: what the vertex could miss, from the coefficient.
-                    let x = if u.v > 0.0 || u.varies {
-                        self.unhidden(p, n, l.source)
-                    } else {
-                        DVec3::ZERO
-                    };
-                    e += x * u.v;
-                    errs.push(err(u, x));
-                }
+                let u = &unsure[next];
+                next += 1;
+                // Unseen by the leaf: what the vertex could miss, from the coefficient.
+                let x = if u.v > 0.0 || u.varies {
+                    self.unhidden(p, n, l.source)
+                } else {
+                    DVec3::ZERO
+                };
+                e += x * u.v;
+                errs.push(err(u, x));
             }
         }
         (e, errs)
