@@ -10,10 +10,11 @@
 //! - rays find it partly hidden and the power is over `eps / SHADOW` (then the receiver
 //!   is split first: a shadow varies over it).
 //!
-//! Otherwise the link is kept with its visibility. Pairs on one face, pairs wholly behind
-//! either plane and fully blocked pairs carry nothing and are dropped. Leaf pairs are kept
-//! whatever they carry. The recursion forks with `rayon::join` and concatenates in a fixed
-//! order, so the links are the same for any thread count.
+//! Otherwise the link is kept with its visibility. Pairs on one face and pairs wholly behind
+//! either plane carry nothing and are dropped; pairs whose rays were all blocked carry
+//! nothing in the solve and are kept apart (`Hidden`, planar sources only) for the final
+//! gather. Leaf pairs are kept whatever they carry. The recursion forks with `rayon::join`
+//! and concatenates in a fixed order, so the links are the same for any thread count.
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
