@@ -63,6 +63,11 @@ pub struct Stats {
     pub N_links: u64,
     pub rays: u64,
     pub bytes_per_leaf: f64,
+    /// Hierarchical solver: pairs whose rays were all blocked (kept apart for the final
+    /// gather), and the seconds of T_rs spent refining links and in the final gather.
+    pub N_hidden: u64,
+    pub T_link: f64,
+    pub T_gather: f64,
     /// Vertex×light pairs: skipped in umbra, computed unoccluded in lit regions, computed
     /// with visibility in penumbra.
     pub pairs_umbra: u64,
@@ -316,6 +321,9 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
         stats.N_links = ind.links;
         stats.rays = ind.rays;
         stats.bytes_per_leaf = ind.bytes_per_leaf;
+        stats.N_hidden = ind.hidden;
+        stats.T_link = ind.t_refine;
+        stats.T_gather = ind.t_gather;
         for (e, i) in irradiance.iter_mut().zip(&ind.irradiance) {
             *e += *i;
         }
@@ -473,7 +481,7 @@ fn output(scene: &Scene, tol: &Tolerances, el: &Elements, colors: &[[f64; 3]]) -
 /// The stats as a text table in the layout of the paper's Tables 2 and 4.
 pub fn stats_table(s: &Stats) -> String {
     let mut t = String::new();
-    let rows: [(&str, String); 27] = [
+    let rows: [(&str, String); 30] = [
         ("receivers before loop split  N_f1", s.N_f1.to_string()),
         ("faces after loop split       N_f2", s.N_f2.to_string()),
         ("discontinuity edges          N_d", s.N_d.to_string()),
@@ -525,6 +533,15 @@ pub fn stats_table(s: &Stats) -> String {
         (
             "links / rays           N_links",
             format!("{} / {}", s.N_links, s.rays),
+        ),
+        ("all-blocked pairs      N_hidden", s.N_hidden.to_string()),
+        (
+            "  of which refinement  T_link (s)",
+            format!("{:.4}", s.T_link),
+        ),
+        (
+            "  final gather         T_gather (s)",
+            format!("{:.4}", s.T_gather),
         ),
         (
             "bytes per leaf (hierarchy+links)",

@@ -74,6 +74,11 @@ pub struct IndirectResult {
     pub leaves: u64,
     pub rays: u64,
     pub bytes_per_leaf: f64,
+    /// Hierarchical solver only: pairs whose rays were all blocked, kept for the final
+    /// gather; seconds spent refining links and in the final gather at the vertices.
+    pub hidden: u64,
+    pub t_refine: f64,
+    pub t_gather: f64,
 }
 
 /// Patches whose apparent size (radius over distance) falls under these use 1 or ~4 rays

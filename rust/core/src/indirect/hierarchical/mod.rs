@@ -134,7 +134,9 @@ pub fn indirect(
         max_links,
         progress,
     );
+    let t_refine = std::time::Instant::now();
     let refined = refiner.run();
+    result.t_refine = t_refine.elapsed().as_secs_f64();
     progress.check()?;
     if refined.over_budget {
         return Err(BakeError::setting(
@@ -150,6 +152,7 @@ pub fn indirect(
     // the final gather at the vertices looks at them again.
     result.links = refined.links.len() as u64;
     result.rays = refined.rays;
+    result.hidden = refined.hidden.len() as u64;
     let g = Gathering::new(refined.links, h.nodes.len());
     let hidden = Gathering::new(refined.hidden, h.nodes.len());
     result.bytes_per_leaf = h.bytes_per_leaf()
@@ -178,6 +181,7 @@ pub fn indirect(
         el,
         occ,
     };
+    let t_gather = std::time::Instant::now();
     let mut at = vertices::gathered(
         &h,
         faces,
@@ -190,6 +194,7 @@ pub fn indirect(
         direct,
         VISIBILITY_SCALE * settings.convergence,
     );
+    result.t_gather = t_gather.elapsed().as_secs_f64();
     if settings.ambient {
         let amb = ambient(&h, &leaves, sol.last_delta);
         at.iter_mut().for_each(|e| *e += amb);
