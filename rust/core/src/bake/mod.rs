@@ -63,8 +63,8 @@ pub struct Stats {
     pub N_links: u64,
     pub rays: u64,
     pub bytes_per_leaf: f64,
-    /// Hierarchical solver: pairs whose rays were all blocked (kept apart for the final
-    /// gather), and the seconds of T_rs spent refining links and in the final gather.
+    /// Hierarchical solver: pairs from planar sources dropped because all their rays were
+    /// blocked, and the seconds of T_rs spent refining links and in the final gather.
     pub N_hidden: u64,
     pub T_link: f64,
     pub T_gather: f64,
@@ -534,7 +534,7 @@ pub fn stats_table(s: &Stats) -> String {
             "links / rays           N_links",
             format!("{} / {}", s.N_links, s.rays),
         ),
-        ("all-blocked pairs      N_hidden", s.N_hidden.to_string()),
+        ("all-blocked, dropped   N_hidden", s.N_hidden.to_string()),
         (
             "  of which refinement  T_link (s)",
             format!("{:.4}", s.T_link),

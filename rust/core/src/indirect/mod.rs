@@ -74,8 +74,9 @@ pub struct IndirectResult {
     pub leaves: u64,
     pub rays: u64,
     pub bytes_per_leaf: f64,
-    /// Hierarchical solver only: pairs whose rays were all blocked, kept for the final
-    /// gather; seconds spent refining links and in the final gather at the vertices.
+    /// Hierarchical solver only: pairs from planar sources that refinement dropped because
+    /// all their rays were blocked (after a second look); seconds spent refining links and
+    /// in the final gather at the vertices.
     pub hidden: u64,
     pub t_refine: f64,
     pub t_gather: f64,

@@ -41,34 +41,6 @@ pub struct Link {
     pub clear: bool,
 }
 
-/// A pair from a planar source whose rays were all blocked: left out of the solve, kept for
-/// the final gather (`vertices`), which needs only its source and its coefficient unhidden.
-/// In clutter they are most of the pairs (room-828: 6.9M of 7.8M), so they are kept in a
-/// third of a `Link`'s bytes.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Hidden {
-    pub receiver: u32,
-    pub source: u32,
-    pub k: f32,
-}
-
-/// Links of either kind, grouped by receiver (`solve::Gathering`).
-pub trait Received {
-    fn receiver(&self) -> u32;
-}
-
-impl Received for Link {
-    fn receiver(&self) -> u32 {
-        self.receiver
-    }
-}
-
-impl Received for Hidden {
-    fn receiver(&self) -> u32 {
-        self.receiver
-    }
-}
-
 /// What a link needs to know of its two ends.
 pub struct Ends<'a> {
     pub r: &'a Node,

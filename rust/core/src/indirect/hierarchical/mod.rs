@@ -148,17 +148,12 @@ pub fn indirect(
             ),
         ));
     }
-    // Pairs whose rays were all blocked (`refined.hidden`) carry nothing in the solve; only
-    // the final gather at the vertices looks at them again.
     result.links = refined.links.len() as u64;
     result.rays = refined.rays;
-    result.hidden = refined.hidden.len() as u64;
+    result.hidden = refined.dropped;
     let g = Gathering::new(refined.links, h.nodes.len());
-    let hidden = Gathering::new(refined.hidden, h.nodes.len());
     result.bytes_per_leaf = h.bytes_per_leaf()
-        + (g.links.len() * std::mem::size_of::<link::Link>()
-            + hidden.links.len() * std::mem::size_of::<link::Hidden>()
-            + (g.start.len() + hidden.start.len()) * 4) as f64
+        + (g.links.len() * std::mem::size_of::<link::Link>() + g.start.len() * 4) as f64
             / nl.max(1) as f64;
 
     progress.set_fraction(0.0);
@@ -187,7 +182,6 @@ pub fn indirect(
         faces,
         el,
         &g,
-        &hidden,
         &solver,
         b,
         &vis,

@@ -16,7 +16,7 @@ use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
 use super::hierarchy::{Hierarchy, NONE};
-use super::link::{Link, Received};
+use super::link::Link;
 use crate::progress::Progress;
 use crate::scene::Face;
 use crate::BakeError;
@@ -45,18 +45,18 @@ pub struct Solution {
 }
 
 /// Links sorted by receiver, with each receiver's range.
-pub struct Gathering<L = Link> {
-    pub links: Vec<L>,
+pub struct Gathering {
+    pub links: Vec<Link>,
     pub start: Vec<u32>,
 }
 
-impl<L: Received> Gathering<L> {
-    pub fn new(mut links: Vec<L>, nodes: usize) -> Self {
+impl Gathering {
+    pub fn new(mut links: Vec<Link>, nodes: usize) -> Self {
         // Stable: each receiver keeps its links in refinement order.
-        links.sort_by_key(|l| l.receiver());
+        links.sort_by_key(|l| l.receiver);
         let mut start = vec![0u32; nodes + 1];
         for l in &links {
-            start[l.receiver() as usize + 1] += 1;
+            start[l.receiver as usize + 1] += 1;
         }
         for i in 0..nodes {
             start[i + 1] += start[i];

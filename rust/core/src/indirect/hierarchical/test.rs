@@ -481,12 +481,12 @@ fn bit_identical_for_any_thread_count() {
     // The plate's shadow on the floor is there: the floor under the plate's middle sees its
     // back (ρ = 0.8, lit by the floor: B ≈ 0.78 of the furnace value) over a factor of about
     // 0.2 in place of walls at about 0.97, so it is about 4 % darker than the open floor; the
-    // progressive solver gives 2.5 % (1.4888 against 1.5289, grids of 5 to 20). This solver
-    // gives 0.07 % (1.5070 against 1.5080): the plate is one face of a cluster, whose links
-    // carry their mean, and the final gather looks again only at planar sources. Open
-    // (issue 11). (This once asked for any vertex under 0.9 of the furnace value: one on the
-    // wall beside the plate had 0.897 from its links' mean visibility, where rays from the
-    // vertex find the opposite wall under the plate in full view.)
+    // progressive solver gives 2.5 % (1.4888 against 1.5289, grids of 5 to 20), this one
+    // 3.2 % (1.4653 against 1.5134). (This once looked at the floor under the plate's corner,
+    // half in its shadow, where the two differed by 0.1 % either way; and once asked for any
+    // vertex under 0.9 of the furnace value: one on the wall beside the plate had 0.897 from
+    // its links' mean visibility, where rays from the vertex find the opposite wall under
+    // the plate in full view.)
     let el = grid_elements(&sc.faces, 5);
     let floor_mean = |keep: &dyn Fn(DVec3) -> bool| {
         let xs: Vec<f64> = (0..el.positions.len())
@@ -495,10 +495,13 @@ fn bit_identical_for_any_thread_count() {
             .collect();
         xs.iter().sum::<f64>() / xs.len() as f64
     };
-    let under = floor_mean(&|p| (p - v(0.5, 0.4, 0.0)).length() < 0.15);
+    let under = floor_mean(&|p| (p - v(0.6, 0.525, 0.0)).length() < 0.08);
     let open = floor_mean(&|p| !(0.2..0.8).contains(&p.x) || !(0.1..0.7).contains(&p.y));
     eprintln!("under the plate {under:.4}, open floor {open:.4}");
-    assert!(under < open, "{under} vs {open}");
+    assert!(
+        under < 0.985 * open && under > 0.94 * open,
+        "{under} vs {open}"
+    );
 }
 
 #[test]

@@ -22,8 +22,8 @@
 //! A look replaces the mean only where it differs by more than its own noise
 //! (`own_visibility`), so that rays through regular blockers (slats) do not scatter
 //! neighbouring vertices about a mean that was right. Pairs whose rays were all blocked are
-//! left out of the solve but kept for this (`refine`): without them, a vertex that saw more
-//! than its links' means could only lose light (slats that hide 60 %: 0.36 seen, not 0.40).
+//! not links, so a vertex that saw more than its links' means could only lose light: that is
+//! why refinement looks twice before it drops one (`refine::CONFIRM_RAYS`).
 //! Cluster sources keep their links' means: a point that sees less of a cluster's far side
 //! sees more of its near side, and a fraction of the whole says nothing of which.
 
@@ -32,7 +32,7 @@ use rayon::prelude::*;
 
 use super::from_point::{seen_from, AreaTable, Seen, Start};
 use super::hierarchy::{Hierarchy, Node, NONE};
-use super::link::{planar_gather, point_coefficient, Hidden};
+use super::link::{planar_gather, point_coefficient};
 use super::solve::{Gathering, Radiosity, Solver};
 use super::visibility::Visibility;
 use crate::geom::hash::mix;
@@ -53,16 +53,14 @@ const NOISE: f64 = 2.0;
 const SURE: f64 = 4.0;
 
 /// Indirect irradiance at every element vertex by a final gather over the links `g`; vertices
-/// on no leaf (under a cover) get 0. `hidden` are the links whose rays were all blocked (left
-/// out of the solve), `direct` the direct irradiance per vertex, and `tolerance` the share
-/// of a vertex's light it may leave to its links' mean visibilities.
+/// on no leaf (under a cover) get 0. `direct` is the direct irradiance per vertex, and
+/// `tolerance` the share of a vertex's light it may leave to its links' mean visibilities.
 #[allow(clippy::too_many_arguments)]
 pub fn gathered(
     h: &Hierarchy,
     faces: &[Face],
     el: &Elements,
     g: &Gathering,
-    hidden: &Gathering<Hidden>,
     solver: &Solver,
     b: &Radiosity,
     vis: &Visibility,
@@ -102,7 +100,6 @@ pub fn gathered(
         faces,
         el,
         g,
-        hidden,
         solver,
         b,
         vis,
@@ -134,7 +131,6 @@ struct Gather<'a> {
     faces: &'a [Face],
     el: &'a Elements,
     g: &'a Gathering,
-    hidden: &'a Gathering<Hidden>,
     solver: &'a Solver<'a>,
     b: &'a Radiosity,
     vis: &'a Visibility<'a>,
@@ -144,7 +140,7 @@ struct Gather<'a> {
 }
 
 /// A link above a leaf from a planar source whose visibility is a mean (`Link::clear`
-/// false), or whose rays were all blocked.
+/// false).
 struct Unsure {
     source: u32,
     /// The link's visibility, and the leaf's own where it looked.
@@ -153,12 +149,10 @@ struct Unsure {
     varies: bool,
     /// What may stand between the leaf and the source (`Visibility::blockers`), once found.
     blockers: Option<Option<Vec<u32>>>,
-    /// The link's coefficient unhidden, for a link left out of the solve (else 0).
-    hidden_k: f64,
 }
 
 impl Gather<'_> {
-    fn links<L>(&self, g: &Gathering<L>, a: u32) -> std::ops::Range<usize> {
+    fn links(&self, g: &Gathering, a: u32) -> std::ops::Range<usize> {
         g.start[a as usize] as usize..g.start[a as usize + 1] as usize
     }
 
@@ -172,7 +166,7 @@ impl Gather<'_> {
     /// itself up are `chain`: first the leaf looks at the links it is least sure of, then
     /// each vertex at those the leaf found in part.
     fn leaf(&self, leaf: u32, chain: &[u32], verts: &[(u32, u32)]) -> Vec<(u32, DVec3)> {
-        let (h, faces, g, hidden) = (self.h, self.faces, self.g, self.hidden);
+        let (h, faces, g) = (self.h, self.faces, self.g);
         let ln = &h.nodes[leaf as usize];
         let n = faces[ln.face as usize].plane.n;
         let mut unsure: Vec<Unsure> = Vec::new();
@@ -184,23 +178,8 @@ impl Gather<'_> {
                         v: l.v as f64,
                         varies: false,
                         blockers: None,
-                        hidden_k: 0.0,
                     });
                 }
-            }
-            // A link whose few rays were all blocked is left out of the solve, but a vertex
-            // may see its source: links through slats that hide 60 % have all 4 rays blocked
-            // one time in eight, and vertices that took their own visibility for the other
-            // links only were 11 % too dark.
-            // (Their sources are all planar: `refine` keeps no other.)
-            for l in &hidden.links[self.links(hidden, a)] {
-                unsure.push(Unsure {
-                    source: l.source,
-                    v: 0.0,
-                    varies: false,
-                    blockers: None,
-                    hidden_k: l.k as f64,
-                });
             }
         }
         // The leaf's look, at its centroid's values: the largest errors first, until what
@@ -208,11 +187,7 @@ impl Gather<'_> {
         if !unsure.is_empty() {
             let c = ln.centroid;
             let (e, errs) = self.gathered_at(c, n, chain, &unsure, |u, x| {
-                if u.hidden_k > 0.0 {
-                    (self.b.mean[u.source as usize] * u.hidden_k).element_sum()
-                } else {
-                    x.element_sum() * u.v.max(1.0 - u.v)
-                }
+                x.element_sum() * u.v.max(1.0 - u.v)
             });
             let darkest = verts
                 .iter()
@@ -224,9 +199,9 @@ impl Gather<'_> {
                 let s = &h.nodes[u.source as usize];
                 let seed = mix(mix(NONE as u64 ^ leaf as u64) ^ u.source as u64);
                 let start = Start::Node(ln);
-                // A link whose rays all agreed is screened through the BVH first: most
+                // A link whose rays all got through is screened through the BVH first: most
                 // screens agree, and the shaft's blocker list pays only over more rays.
-                let screened = (u.v == 0.0 || u.v == 1.0)
+                let screened = (u.v == 1.0)
                     .then(|| seen_from(self.vis, &self.table, start, s, None, SCREEN_RAYS, seed));
                 if screened.is_some_and(|x| x.fraction().is_none_or(|f| f == u.v)) {
                     continue;
@@ -284,18 +259,6 @@ impl Gather<'_> {
                     errs.push(err(u, x));
                 }
             }
-            for l in &self.hidden.links[self.links(self.hidden, a)] {
-                let u = &unsure[next];
-                next += 1;
-                // Unseen by the leaf: what the vertex could miss, from the coefficient.
-                let x = if u.v > 0.0 || u.varies {
-                    self.unhidden(p, n, l.source)
-                } else {
-                    DVec3::ZERO
-                };
-                e += x * u.v;
-                errs.push(err(u, x));
-            }
         }
         (e, errs)
     }
@@ -331,14 +294,7 @@ impl Gather<'_> {
             let seed = mix(mix(v as u64) ^ u.source as u64);
             let start = Start::Point(p, n, face);
             let (own, _) = own_visibility(self.vis, &self.table, start, s, list, u.v, seed, None);
-            if own != u.v {
-                let x = if xs[i] == DVec3::ZERO {
-                    self.unhidden(p, n, u.source)
-                } else {
-                    xs[i]
-                };
-                e += x * (own - u.v);
-            }
+            e += xs[i] * (own - u.v);
         }
         e
     }
