@@ -414,11 +414,11 @@ fn to_f32(v: DVec3) -> Vec3A {
     Vec3A::new(v.x as f32, v.y as f32, v.z as f32)
 }
 
-/// Where the 8-wide BVH's traversal starts counting a ray's nodes: it skips every child box
-/// whose entry lies under 1e-4 along the ray (obvhs' `cwbvh::node::EPSILON`), which would miss
-/// a face a tenth of a millimetre from a segment's start (a floor point beside a box's wall:
-/// 68k of room-78's rays). So its rays start this far behind and run this much longer; the
-/// faces found are tested exactly on the segment itself.
+/// The 8-wide BVH's traversal counts a child box as missed when the ray leaves it under 1e-4
+/// along the ray (obvhs' `cwbvh::node::EPSILON`), which misses a face a tenth of a millimetre
+/// from a segment's start (a floor point beside a box's wall: 68k of room-78's rays). So its
+/// rays start this far behind and run this much longer; the faces found are tested exactly
+/// on the segment itself.
 const WIDE_BACK: f32 = 2.0e-4;
 
 fn wide_ray(r: Ray) -> Ray {
@@ -476,6 +476,28 @@ pub(crate) mod test {
             quad(v(0., 0., 0.), v(0.5, 0., 0.), v(0., 0.5, 0.)),
             quad(v(2., 0., 0.), v(0., 0., 1.), v(0., 1., 0.)),
         ])
+    }
+
+    #[test]
+    fn a_face_right_at_a_segments_start_blocks_it() {
+        // The wide BVH's traversal skips boxes left under 1e-4 along a ray (`WIDE_BACK`):
+        // a face 3e-5 from the start, in a scene small enough for the boxes' padding (1e-5 of
+        // its size) to be thinner than that, among enough faces for the BVH to have levels.
+        let mut faces: Vec<Poly> = (0..64)
+            .map(|i| {
+                let x = 0.3 + 0.08 * (i % 8) as f64;
+                let y = 0.3 + 0.08 * (i / 8) as f64;
+                quad(v(x, y, 0.0), v(0.03, 0., 0.), v(0., 0.03, 0.))
+            })
+            .collect();
+        faces.push(quad(v(0.1, 0.1, 0.0), v(0.05, 0., 0.), v(0., 0.05, 0.)));
+        let o = Occluders::new(&faces);
+        for d in [1e-5, 3e-5, 1e-4, 3e-4] {
+            let a = v(0.1, 0.1, d);
+            assert!(o.segment_blocked(a, v(0.11, 0.095, -0.1)), "{d}");
+            assert!(o.ray_blocked(a, v(0.1, -0.05, -1.0)), "{d}");
+            assert!(!o.segment_blocked(a, v(0.11, 0.095, 0.1)), "{d}");
+        }
     }
 
     #[test]
