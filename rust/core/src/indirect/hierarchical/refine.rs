@@ -13,8 +13,8 @@
 //! Otherwise the link is kept with its visibility. Pairs on one face and pairs wholly behind
 //! either plane carry nothing and are dropped, and so are pairs whose rays were all blocked
 //! (from a planar source, after `CONFIRM_RAYS` more). Leaf pairs are kept whatever they
-//! carry. The recursion forks with `rayon::join`
-//! and concatenates in a fixed order, so the links are the same for any thread count.
+//! carry. The recursion forks with `rayon::join` and concatenates in a fixed order, so the
+//! links are the same for any thread count.
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
