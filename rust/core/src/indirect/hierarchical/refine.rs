@@ -288,8 +288,7 @@ impl<'a> Refiner<'a> {
             return;
         }
         let clear = blockers.as_ref().is_some_and(|l| l.is_empty());
-        let mut link = ends.link(h, self.vis.el, r, s, v, clear, !faint);
-        link.v = v as f32;
+        let link = ends.link(h, self.vis.el, r, s, v, clear, !faint);
         if link.k > 0.0 || ends.factor_bound() > 0.0 {
             out.links.push(link);
             let n = self.links.fetch_add(1, Ordering::Relaxed) + 1;
