@@ -72,10 +72,10 @@ class PenumbraSettings(bpy.types.PropertyGroup):
         name="Solver",
         description="How bounced light is computed",
         items=(
-            ("PROGRESSIVE", "Progressive", "Progressive refinement over patches: the most accurate on small scenes"),
-            ("HIERARCHICAL", "Hierarchical", "Hierarchical radiosity with clusters: for large scenes, where progressive refinement is slow"),
+            ("HIERARCHICAL", "Hierarchical", "Hierarchical radiosity with clusters on the discontinuity mesh: follows every shadow, and scales to rooms"),
+            ("PROGRESSIVE", "Progressive", "Progressive refinement over grid patches (the round-1 solver): fast on a few dozen faces, slow on rooms"),
         ),
-        default="PROGRESSIVE",
+        default="HIERARCHICAL",
     )
     convergence: FloatProperty(
         name="Convergence",

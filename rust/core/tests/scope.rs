@@ -62,39 +62,46 @@ fn scenery_without_output_shades_the_floor_the_same() {
 /// box; at the patch size it was 6.5 %).
 #[test]
 fn scenery_is_meshed_coarsely_when_it_only_reflects() {
-    let mut light = area_light("Light", quad([0.1, 0., 2.], 0.4, 0.4, false));
-    light.radiance = Some([4.0; 3]);
-    let settings = SettingsJson {
-        indirect: Some(true),
-        ..Default::default()
-    };
-    let make = |floor_output: Option<bool>| {
-        let mut floor = mesh("Floor", vec![quad([0., 0., 0.], 2., 2., true)]);
-        floor.output = floor_output;
-        let occ = mesh("Occluder", cuboid([-0.3, -0.3, 0.6], [0.3, 0.3, 0.9]));
-        scene(vec![floor, occ], vec![light.clone()], settings.clone())
-    };
-    let full = bake(&make(None));
-    let scenery = bake(&make(Some(false)));
-    assert!(
-        scenery.stats.N_e * 3 < full.stats.N_e,
-        "{} elements as scenery, {} as output",
-        scenery.stats.N_e,
-        full.stats.N_e
-    );
-    let (a, b) = (&full.meshes[1], &scenery.meshes[1]);
-    assert_eq!(a.positions, b.positions);
-    let top = a.colors.iter().map(|c| c[0]).fold(0.0, f64::max);
-    // The box's underside sees only the floor: its light is all reflected.
-    let under: Vec<usize> = (0..a.positions.len())
-        .filter(|&i| (a.positions[i][2] - 0.6).abs() < 1e-9)
-        .collect();
-    assert!(!under.is_empty());
-    for i in under {
-        let (x, y) = (a.colors[i][0], b.colors[i][0]);
+    // The box's underside sees only the floor, whose light it reflects: meshed as scenery
+    // (coarse), the floor must still send about the same. Worst differences: progressive
+    // refinement 3.0 %; the hierarchical solver 5.1 % (its floor leaves are the floor's
+    // elements, whose direct light is their interpolated mean, so a coarse floor moves the
+    // brightest part of the underside most).
+    for (solver, bound) in [("progressive", 0.05), ("hierarchical", 0.07)] {
+        let mut light = area_light("Light", quad([0.1, 0., 2.], 0.4, 0.4, false));
+        light.radiance = Some([4.0; 3]);
+        let settings = SettingsJson {
+            indirect: Some(true),
+            indirect_solver: Some(solver.into()),
+            ..Default::default()
+        };
+        let make = |floor_output: Option<bool>| {
+            let mut floor = mesh("Floor", vec![quad([0., 0., 0.], 2., 2., true)]);
+            floor.output = floor_output;
+            let occ = mesh("Occluder", cuboid([-0.3, -0.3, 0.6], [0.3, 0.3, 0.9]));
+            scene(vec![floor, occ], vec![light.clone()], settings.clone())
+        };
+        let full = bake(&make(None));
+        let scenery = bake(&make(Some(false)));
         assert!(
-            x > 0.0 && (x - y).abs() <= 0.05 * x.max(0.05 * top),
-            "{x} {y}"
+            scenery.stats.N_e * 3 < full.stats.N_e,
+            "{solver}: {} elements as scenery, {} as output",
+            scenery.stats.N_e,
+            full.stats.N_e
         );
+        let (a, b) = (&full.meshes[1], &scenery.meshes[1]);
+        assert_eq!(a.positions, b.positions);
+        let top = a.colors.iter().map(|c| c[0]).fold(0.0, f64::max);
+        let under: Vec<usize> = (0..a.positions.len())
+            .filter(|&i| (a.positions[i][2] - 0.6).abs() < 1e-9)
+            .collect();
+        assert!(!under.is_empty());
+        for i in under {
+            let (x, y) = (a.colors[i][0], b.colors[i][0]);
+            assert!(
+                x > 0.0 && (x - y).abs() <= bound * x.max(0.05 * top),
+                "{solver}: {x} {y}"
+            );
+        }
     }
 }

@@ -20,8 +20,8 @@ const SUN: f64 = 3.0;
 /// Half-sizes: the plane at height 1, the floor at 0.
 const PLANE: f64 = 3.0;
 const FLOOR: f64 = 0.5;
-/// The indirect solvers, as `settings.indirect_solver` names them (`None`: the default).
-const SOLVERS: [Option<&str>; 2] = [None, Some("hierarchical")];
+/// The indirect solvers, as `settings.indirect_solver` names them.
+const SOLVERS: [Option<&str>; 2] = [Some("progressive"), Some("hierarchical")];
 
 fn sun() -> LightJson {
     LightJson {

@@ -23,6 +23,8 @@ pub(crate) fn quad(c: DVec3, u: DVec3, w: DVec3, albedo: f64, le: DVec3) -> Face
 
 pub(crate) fn scene(faces: Vec<Face>, settings: impl FnOnce(&mut Settings)) -> Scene {
     let mut s = Settings::from_json(&SettingsJson::default(), 1.0).unwrap();
+    // This module tests the progressive solver; hierarchical tests choose theirs.
+    s.indirect_solver = crate::scene::settings::IndirectSolver::Progressive;
     settings(&mut s);
     let pts = faces.iter().flat_map(|f| f.verts.iter().copied());
     let lo = pts.clone().fold(DVec3::splat(f64::INFINITY), DVec3::min);

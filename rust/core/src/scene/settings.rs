@@ -144,8 +144,8 @@ impl Settings {
             }
         };
         let indirect_solver = match s.indirect_solver.as_deref() {
-            None | Some("progressive") => IndirectSolver::Progressive,
-            Some("hierarchical") => IndirectSolver::Hierarchical,
+            Some("progressive") => IndirectSolver::Progressive,
+            None | Some("hierarchical") => IndirectSolver::Hierarchical,
             Some(o) => {
                 return Err(BakeError::setting(
                     "indirect_solver",
