@@ -39,7 +39,7 @@ fn within(s: &Solid, pts: &[DVec3], eps: f64) -> bool {
 }
 
 /// The six planes whose positive sides meet in box `b`, for a box-tree query.
-fn box_planes(b: &Aabb) -> [Plane; 6] {
+pub(crate) fn box_planes(b: &Aabb) -> [Plane; 6] {
     [
         Plane::new(DVec3::X, b.min.x),
         Plane::new(DVec3::Y, b.min.y),

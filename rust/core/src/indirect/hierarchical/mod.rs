@@ -16,15 +16,17 @@
 //! (`vertices`). Every step gives the same bits
 //! for any thread count.
 //!
-//! Parts of faces lying against another face (`covered`) neither shoot nor receive. The
-//! backs of thin faces with something behind them are faces of their own in the hierarchy
-//! (`back`), which receive and shoot into the half-space behind.
+//! Parts of faces lying against another face (`covered`) or buried in another solid
+//! (`buried`) neither shoot nor receive. The backs of thin faces with something behind them
+//! are faces of their own in the hierarchy (`back`), which receive and shoot into the
+//! half-space behind.
 //!
 //! Settings: `convergence` sets both the link tolerance and the end of the solve;
 //! `visibility_rays` is the ray count for links carrying the most; `max_shots` caps the
 //! sweeps; `patch_size` is not used (the hierarchy replaces the grid patches).
 
 mod back;
+mod buried;
 mod from_point;
 mod hierarchy;
 mod link;
@@ -90,7 +92,8 @@ pub fn indirect(
     // From here on, faces include the backs of thin faces (`back`).
     let backs = back::Backs::new(scene, occ);
     let faces: &[crate::scene::Face] = &backs.faces;
-    let keep = |t| !covered(scene, el, &covers, t);
+    let buried = buried::Buried::new(scene, 1e-6 * scene.diagonal());
+    let keep = |t| !covered(scene, el, &covers, t) && !buried.buried(el, t);
     let mut h = Hierarchy::build_two_sided(faces, el, keep, leaf_radius, &backs.of);
     h.set_boxes(faces, el);
     let nl = h.order.len();
