@@ -174,10 +174,9 @@ pub fn seen_from(
 fn point_of(vis: &Visibility, table: &AreaTable, n: &Node, u: f64, v: f64) -> (DVec3, DVec3) {
     let h = vis.h;
     let (pos, t) = table.at(n, u);
-    let tri = h.order[pos as usize] as usize;
-    let [a, b, c] = vis.el.triangles[tri].map(|i| vis.el.positions[i as usize]);
+    let [a, b, c, leaf_face] = h.corners[pos as usize];
+    let [a, b, c] = [a, b, c].map(|i| vis.el.positions[i as usize]);
     let st = t.sqrt();
     let y = a * (1.0 - st) + b * (st * (1.0 - v)) + c * (st * v);
-    let leaf_face = h.nodes[h.leaf_node[pos as usize] as usize].face;
     (y, vis.faces[leaf_face as usize].plane.n)
 }

@@ -169,8 +169,8 @@ impl Visibility<'_> {
         } else {
             (n.lo + i % count, i / count, k.div_ceil(count))
         };
-        let t = self.h.order[leaf as usize] as usize;
-        let [a, b, c] = self.el.triangles[t].map(|v| self.el.positions[v as usize]);
+        let [a, b, c, face] = self.h.corners[leaf as usize];
+        let [a, b, c] = [a, b, c].map(|v| self.el.positions[v as usize]);
         let (mut u, mut v) = if m == 1 && round == 0 {
             (1.0 / 3.0, 1.0 / 3.0)
         } else {
@@ -183,7 +183,6 @@ impl Visibility<'_> {
             (u, v) = (1.0 - u, 1.0 - v);
         }
         // The leaf's face, not the triangle's: a back leaf faces the other way.
-        let face = self.h.nodes[self.h.leaf_node[leaf as usize] as usize].face;
         let normal = self.faces[face as usize].plane.n;
         (a * (1.0 - u - v) + b * u + c * v, normal)
     }
