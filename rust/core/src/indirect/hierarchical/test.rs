@@ -252,8 +252,10 @@ fn floor_under_a_table_sees_no_ceiling_through_it() {
     }
     let mean = sum / count as f64;
     eprintln!("under the table: {count} vertices, mean ratio {mean:.4}, worst {worst:.4}");
-    // Measured 1.0097 and 0.094 (with each link's mean visibility: 1.056 and 0.26). A vertex
-    // leaves up to `VISIBILITY_SCALE` × convergence (10 %) of its light to the means.
+    // Measured 1.0097 and 0.094 (with each link's mean visibility: 1.056 and 0.26); 1.0138
+    // and 0.119 since most vertices of a leaf interpolate the visibilities its anchors found
+    // (`vertices::ANCHORS`; a leaf's first look with 8 rays instead of 16 made it 0.124). A
+    // vertex leaves up to `VISIBILITY_SCALE` × convergence (10 %) of its light to the means.
     assert!(count > 50);
     assert!((mean - 1.0).abs() < 0.02, "{mean}");
     assert!(worst < 0.12, "{worst}");
