@@ -393,22 +393,7 @@ pub(super) fn receiver_triangles(
                 / 3.0
         };
         let cs: Vec<DVec3> = (n.lo..n.hi).map(centre).collect();
-        let mut chosen = vec![0usize];
-        let mut near = vec![f64::INFINITY; cs.len()];
-        while chosen.len() < k as usize {
-            let last = cs[*chosen.last().unwrap()];
-            let mut far = 0;
-            for (i, c) in cs.iter().enumerate() {
-                near[i] = near[i].min((*c - last).length_squared());
-                if near[i] > near[far] {
-                    far = i;
-                }
-            }
-            if near[far] <= 0.0 {
-                break;
-            }
-            chosen.push(far);
-        }
+        let chosen = super::vertices::spread(&cs, k as usize);
         let mut w = vec![0.0; chosen.len()];
         for (i, c) in cs.iter().enumerate() {
             let j = (0..chosen.len())

@@ -365,7 +365,7 @@ impl Gather<'_> {
 }
 
 /// `k` of `points` spread over them (farthest-point picks from the first), by index.
-fn spread(points: &[DVec3], k: usize) -> Vec<usize> {
+pub(super) fn spread(points: &[DVec3], k: usize) -> Vec<usize> {
     let mut chosen = vec![0usize];
     let mut near = vec![f64::INFINITY; points.len()];
     while chosen.len() < k.min(points.len()) {
