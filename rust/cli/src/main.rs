@@ -214,7 +214,7 @@ fn run(cli: Cli) -> ExitCode {
             } else if glb {
                 std::fs::write(&output, penumbra_cli::gltf::to_glb(&bake))
             } else {
-                std::fs::write(&output, bake.to_json())
+                std::fs::File::create(&output).and_then(|f| bake.write_json(f))
             };
             match written {
                 Ok(()) => {}
@@ -299,3 +299,7 @@ fn spawn_bar(p: Arc<Progress>) -> std::thread::JoinHandle<()> {
         bar.finish_and_clear();
     })
 }
+
+#[cfg(not(target_env = "msvc"))]
+#[global_allocator]
+static GLOBAL: tikv_jemallocator::Jemalloc = tikv_jemallocator::Jemalloc;
