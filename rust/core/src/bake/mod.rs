@@ -280,7 +280,7 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
         stats.refine_evaluations += m.refine.evaluations;
     }
     let elements = assemble(scene, &meshes);
-    // The regions and per-receiver meshes are done with. Freeing them (a million small
+    // The per-receiver meshes are done with. Freeing them (a million small
     // allocations on a floor under a thousand shadows; 0.2 s in a debug build) happens on a
     // thread of its own, so that neither a cancel in a later stage nor the end of the bake
     // waits for it.
