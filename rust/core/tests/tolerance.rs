@@ -427,21 +427,8 @@ fn box_foot_corner_takes_each_sides_limit() {
 /// floor 86k vertices, against 51k without; room-8328's floor grew from 206k to 1.03M.
 #[test]
 fn floor_under_many_shadows_meets_its_tolerance() {
-    let step = 3.0 / 20.0;
-    let quads: Vec<Vec<[f64; 3]>> = (0..400usize)
-        .map(|k| {
-            let (i, j) = ((k % 20) as f64, (k / 20) as f64);
-            let z = 0.5 + 0.3 * ((k * 7919) % 13) as f64 / 13.0;
-            let c = [-1.5 + (i + 0.5) * step, -1.5 + (j + 0.5) * step, z];
-            quad(c, 0.3 * step, 0.3 * step, true)
-        })
-        .collect();
-    let s = scene(
-        vec![
-            mesh("Floor", vec![quad([0., 0., 0.], 2., 2., true)]),
-            mesh("Quads", quads),
-        ],
-        vec![area_light("Lamp", quad([0., 0., 3.], 0.3, 0.3, false))],
+    let s = quads_scene(
+        20,
         SettingsJson {
             indirect: Some(false),
             lighting_only: Some(true),

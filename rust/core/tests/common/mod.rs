@@ -343,3 +343,38 @@ pub fn square_over_square(x: f64, y: f64) -> (f64, f64) {
     );
     (full, hid)
 }
+
+/// The worst-case scripts' light: 0.6 × 0.6 at height 3, facing down, radiance 1.
+pub fn lamp() -> Vec<[f64; 3]> {
+    quad([0., 0., 3.], 0.3, 0.3, false)
+}
+
+/// `side` × `side` small quads at 13 heights in 0.5–0.8 over a 4 × 4 floor, under the lamp
+/// (quads2000 is 45 × 45).
+pub fn quads(side: usize) -> Vec<Vec<[f64; 3]>> {
+    let step = 3.0 / side as f64;
+    (0..side * side)
+        .map(|k| {
+            let (i, j) = ((k % side) as f64, (k / side) as f64);
+            let z = 0.5 + 0.3 * ((k * 7919) % 13) as f64 / 13.0;
+            quad(
+                [-1.5 + (i + 0.5) * step, -1.5 + (j + 0.5) * step, z],
+                0.3 * step,
+                0.3 * step,
+                true,
+            )
+        })
+        .collect()
+}
+
+/// The quads over the floor under `lamp` (tests/worst_cases.rs, tests/tolerance.rs).
+pub fn quads_scene(side: usize, settings: SettingsJson) -> SceneJson {
+    scene(
+        vec![
+            mesh("Floor", vec![quad([0., 0., 0.], 2., 2., true)]),
+            mesh("Quads", quads(side)),
+        ],
+        vec![area_light("Lamp", lamp())],
+        settings,
+    )
+}
