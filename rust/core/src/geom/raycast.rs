@@ -170,6 +170,66 @@ impl Occluders {
         })
     }
 
+    /// [`segment_blocked_skip`](Self::segment_blocked_skip), with the face that blocks (the
+    /// first the traversal finds).
+    pub fn segment_blocker_skip(&self, a: DVec3, b: DVec3, skip: &[u32]) -> Option<u32> {
+        let bvh = self.wide.as_ref()?;
+        let d = b - a;
+        let len = d.length();
+        if !(len > self.tol) || !len.is_finite() {
+            return None;
+        }
+        let ray = wide_ray(self.bvh_ray(a, d / len, len)?);
+        let mut found = None;
+        bvh.ray_traverse_miss(ray, |ray, i| {
+            let id = bvh.primitive_indices[i];
+            if self.ray_meets_box(ray, id)
+                && !skip.contains(&id)
+                && self.face_crosses_segment(id, a, b)
+            {
+                found = Some(id);
+                0.0
+            } else {
+                f32::INFINITY
+            }
+        });
+        found
+    }
+
+    /// [`segment_blocked_by`](Self::segment_blocked_by), with the face that blocks.
+    pub fn segment_blocker_among(&self, a: DVec3, b: DVec3, faces: &[u32]) -> Option<u32> {
+        faces
+            .iter()
+            .copied()
+            .find(|&f| self.face_crosses_segment(f, a, b))
+    }
+
+    /// Whether face `id` blocks every segment from a point of the convex hull of `a` to a
+    /// point of the convex hull of `b`: the two lie on opposite sides of its plane, each more
+    /// than the tolerance off it, and every segment between their points crosses the plane
+    /// inside the polygon, more than the tolerance from its edges. Where the plane cuts the
+    /// hull of both sets it cuts it in the hull of those crossings, so the polygon, being
+    /// convex, holds the whole cut: no ray between the two can pass.
+    pub fn face_covers(&self, id: u32, a: &[DVec3], b: &[DVec3]) -> bool {
+        let f = &self.faces[id as usize];
+        if f.edges.is_empty() || a.is_empty() || b.is_empty() {
+            return false;
+        }
+        let da: Vec<f64> = a.iter().map(|&p| f.plane.dist(p)).collect();
+        let db: Vec<f64> = b.iter().map(|&p| f.plane.dist(p)).collect();
+        let side = |d: &[f64], s: f64| d.iter().all(|&x| x * s > self.tol);
+        let s = if da[0] > 0.0 { 1.0 } else { -1.0 };
+        if !side(&da, s) || !side(&db, -s) {
+            return false;
+        }
+        a.iter().zip(&da).all(|(&p, &dp)| {
+            b.iter().zip(&db).all(|(&q, &dq)| {
+                let x = p + (q - p) * (dp / (dp - dq));
+                f.edges.iter().all(|(m, c)| m.dot(x) - c > self.tol)
+            })
+        })
+    }
+
     /// True if one of `faces` crosses the open segment `a`–`b`: for callers that already
     /// know the few faces that could be in the way.
     pub fn segment_blocked_by(&self, a: DVec3, b: DVec3, faces: &[u32]) -> bool {
@@ -647,5 +707,53 @@ pub(crate) mod test {
         let o = Occluders::new::<Poly>(&[]);
         assert!(!o.segment_blocked(DVec3::ZERO, DVec3::ONE));
         assert!(!o.ray_blocked(DVec3::ZERO, DVec3::ONE));
+    }
+
+    #[test]
+    fn a_face_covers_only_what_every_segment_through_it_hides() {
+        let o = two();
+        let tri = |x: f64, y: f64, z: f64, s: f64| {
+            vec![v(x - s, y - s, z), v(x + s, y - s, z), v(x, y + s, z)]
+        };
+        assert!(o.face_covers(0, &tri(0.0, 0.0, 1.0, 0.1), &tri(0.0, 0.0, -1.0, 0.1)));
+        // Reaching past the square's edge below: a segment from above passes it by.
+        assert!(!o.face_covers(0, &tri(0.0, 0.0, 1.0, 0.1), &tri(0.0, 0.0, -1.0, 0.95)));
+        assert!(!o.segment_blocked(v(-0.1, -0.1, 1.0), v(-0.95, -0.95, -1.0)));
+        // Both above, or one touching the plane: nothing to cover.
+        assert!(!o.face_covers(0, &tri(0.0, 0.0, 1.0, 0.1), &tri(0.0, 0.0, 0.5, 0.1)));
+        assert!(!o.face_covers(0, &tri(0.0, 0.0, 1.0, 0.1), &tri(0.0, 0.0, 0.0, 0.1)));
+
+        // Random triangles on either side: where the square covers a pair, no segment
+        // between points of the two gets by it.
+        let mut k = 0u64;
+        let mut next = || {
+            k += 1;
+            crate::geom::hash::unit(crate::geom::hash::mix(k))
+        };
+        let (mut covered, mut open) = (0, 0);
+        for _ in 0..400 {
+            let mut pick = |z: f64| {
+                let (x, y, s) = (next() - 0.5, next() - 0.5, 0.3 * next());
+                tri(1.2 * x, 1.2 * y, z * (0.05 + next()), s)
+            };
+            let (a, b) = (pick(1.0), pick(-1.0));
+            if !o.face_covers(0, &a, &b) {
+                open += 1;
+                continue;
+            }
+            covered += 1;
+            let mut point = |t: &[DVec3]| {
+                let (mut u, mut w) = (next(), next());
+                if u + w > 1.0 {
+                    (u, w) = (1.0 - u, 1.0 - w);
+                }
+                t[0] + (t[1] - t[0]) * u + (t[2] - t[0]) * w
+            };
+            for _ in 0..50 {
+                let (p, q) = (point(&a), point(&b));
+                assert!(o.segment_blocked(p, q), "{a:?} {b:?}: {p} {q}");
+            }
+        }
+        assert!(covered > 40 && open > 40, "{covered} covered, {open} not");
     }
 }

@@ -129,6 +129,8 @@ pub fn indirect(
             faces,
             el,
             occ,
+            solid_of: &scene.face_occluder,
+            occluders: &scene.occluders,
         },
         &b_max,
         &b_range,
@@ -178,6 +180,8 @@ pub fn indirect(
         faces,
         el,
         occ,
+        solid_of: &scene.face_occluder,
+        occluders: &scene.occluders,
     };
     let t_gather = std::time::Instant::now();
     let mut at = vertices::gathered(

@@ -12,7 +12,10 @@
 //!
 //! Otherwise the link is kept with its visibility. Pairs on one face and pairs wholly behind
 //! either plane carry nothing and are dropped, and so are pairs whose rays were all blocked
-//! (from a planar source, after `CONFIRM_RAYS` more). Leaf pairs are kept whatever they
+//! (from a planar source, after `CONFIRM_RAYS` more, unless the face that blocked the first
+//! ray, or the convex solid it bounds, hides the whole pair: `Visibility::covers`). A face
+//! that blocked a pair's ray is handed down to the pairs it splits into, which it may hide
+//! whole without a ray (a box between two walls' elements). Leaf pairs are kept whatever they
 //! carry. The recursion forks with `rayon::join` and concatenates in a fixed order, so the
 //! links are the same for any thread count.
 
@@ -117,7 +120,7 @@ impl<'a> Refiner<'a> {
     pub fn run(&self) -> Refined {
         let mut out = Out::default();
         if !self.vis.h.nodes.is_empty() {
-            self.refine(0, 0, None, &mut out);
+            self.refine(0, 0, Given::default(), &mut out);
         }
         Refined {
             links: out.links,
@@ -148,7 +151,7 @@ impl<'a> Refiner<'a> {
         }
     }
 
-    fn refine(&self, r: u32, s: u32, inherited: Option<&[u32]>, out: &mut Out) {
+    fn refine(&self, r: u32, s: u32, given: Given<'_>, out: &mut Out) {
         if self.stop.load(Ordering::Relaxed) {
             return;
         }
@@ -159,7 +162,7 @@ impl<'a> Refiner<'a> {
                 return;
             }
             let [a, b] = rn.kids;
-            return self.split(&[(a, a), (a, b), (b, a), (b, b)], inherited, out);
+            return self.split(&[(a, a), (a, b), (b, a), (b, b)], given, out);
         }
         // A face's front and back (`back`) see nothing of each other either.
         let h = self.vis.h;
@@ -188,6 +191,10 @@ impl<'a> Refiner<'a> {
             self.settle(rn, sn);
             return;
         }
+        // Hidden whole by the face, or the solid, that hid a pair above it.
+        if given.hint.is_some_and(|f| self.vis.covers(f, rn, sn)) {
+            return self.hidden(rn, sn, out);
+        }
         let both_leaves = rn.is_leaf() && sn.is_leaf();
         let dist = ends.offset().length();
         let near = dist < NEAR * (rn.radius() + sn.radius());
@@ -199,7 +206,7 @@ impl<'a> Refiner<'a> {
         let faint = power <= self.eps / NEAR_POWER;
         let near = near && !faint;
         if !both_leaves && (near || error > self.eps) && !self.over_budget() {
-            return self.split_larger(r, s, inherited, out);
+            return self.split_larger(r, s, given, out);
         }
         // The link gives every point of the receiver its mean factor: where the factor
         // varies over the receiver (a wall whose part by a corner sees less of the far
@@ -218,7 +225,7 @@ impl<'a> Refiner<'a> {
                 let carried = self.b_max[s as usize] * f0 * rn.area;
                 if vary > VARY_REL * f0 && carried > self.eps / VARY_POWER {
                     let [a, b] = rn.kids;
-                    return self.split(&[(a, s), (b, s)], inherited, out);
+                    return self.split(&[(a, s), (b, s)], given, out);
                 }
             }
         }
@@ -232,13 +239,13 @@ impl<'a> Refiner<'a> {
                 && carried > self.eps / SOURCE_VARY_POWER
             {
                 let [a, b] = sn.kids;
-                return self.split(&[(r, a), (r, b)], inherited, out);
+                return self.split(&[(r, a), (r, b)], given, out);
             }
         }
         // A faint pair is never split, so its shaft list would only spare it a few rays;
         // in clutter most shaft queries give up past their cap anyway (room-245: 2.1M of
         // 2.9M), and the query costs more than the rays.
-        let blockers = match inherited {
+        let blockers = match given.blockers {
             Some(l) => Some(self.vis.blockers_among(rn, sn, l)),
             None if faint => None,
             None => self.vis.blockers(rn, sn),
@@ -247,37 +254,46 @@ impl<'a> Refiner<'a> {
         // rays can miss a small blocker near one end (a leg under a seat).
         let listed = blockers.as_ref().is_some_and(|l| !l.is_empty());
         if listed && !both_leaves && power > self.eps / PARTIAL && !self.over_budget() {
-            return self.split_larger(r, s, blockers.as_deref(), out);
+            let hint = given.hint;
+            return self.split_larger(r, s, Given::new(blockers.as_deref(), hint), out);
         }
         // Something may be in the way of a link carrying much: sample it more densely.
         let rays = if error > self.eps / 4.0 { self.rays } else { 4 };
         // A pair that any blocked segment would split needs no more rays after the first.
         let splits = !both_leaves && power > self.eps / SHADOW;
-        let (mut v, mut cast) = self
+        let look = self
             .vis
             .fraction_among(rn, sn, blockers.as_deref(), rays, splits);
+        let (mut v, mut cast) = (look.open, look.cast);
+        // A face that blocked the first rays may hide the whole pair (a box between two
+        // others): then it is fully blocked, with no second look and nothing to split.
+        let covered = v == 0.0
+            && look
+                .blocker
+                .is_some_and(|f| given.hint != Some(f) && self.vis.covers(f, rn, sn));
         // A few rays all blocked may have missed a gap (see `CONFIRM_RAYS`). Cluster sources
         // are dropped on the first rays: their links keep a mean that no point refines.
         // A pair that splits on any blocked ray needs none. The first rays count too: the
         // second look is made only when they were all blocked, which biases it high.
-        if v == 0.0 && cast > 0 && cast < CONFIRM_RAYS && !splits && sn.is_planar() {
-            let (more, more_cast) =
-                self.vis
-                    .fraction_among(rn, sn, blockers.as_deref(), CONFIRM_RAYS, false);
-            v = more * more_cast as f64 / (cast + more_cast) as f64;
-            cast += more_cast;
+        if v == 0.0 && !covered && cast > 0 && cast < CONFIRM_RAYS && !splits && sn.is_planar() {
+            let more = self
+                .vis
+                .fraction_among(rn, sn, blockers.as_deref(), CONFIRM_RAYS, false);
+            v = more.open * more.cast as f64 / (cast + more.cast) as f64;
+            cast += more.cast;
         }
         if cast > 0 {
             self.rays_cast.fetch_add(cast as u64, Ordering::Relaxed);
         }
         // Partly hidden: the shadow varies over the receiver, and a mean over it would
         // light its dark part (the seat right above a leg). Split the receiver first.
-        if v < 1.0 && (v > 0.0 || cast > 0) && splits && !self.over_budget() {
+        if v < 1.0 && (v > 0.0 || cast > 0) && !covered && splits && !self.over_budget() {
+            let given = Given::new(blockers.as_deref(), look.blocker.or(given.hint));
             return if rn.is_leaf() {
-                self.split_larger(r, s, blockers.as_deref(), out)
+                self.split_larger(r, s, given, out)
             } else {
                 let [a, b] = rn.kids;
-                self.split(&[(a, s), (b, s)], blockers.as_deref(), out)
+                self.split(&[(a, s), (b, s)], given, out)
             };
         }
         self.settle(rn, sn);
@@ -302,6 +318,14 @@ impl<'a> Refiner<'a> {
         }
     }
 
+    /// Settles a pair that nothing passes between.
+    fn hidden(&self, rn: &Node, sn: &Node, out: &mut Out) {
+        self.settle(rn, sn);
+        if sn.is_planar() {
+            out.dropped += 1;
+        }
+    }
+
     fn over_budget(&self) -> bool {
         let over = self.links.load(Ordering::Relaxed) > self.max_links;
         if over {
@@ -310,27 +334,27 @@ impl<'a> Refiner<'a> {
         over
     }
 
-    fn split_larger(&self, r: u32, s: u32, inherited: Option<&[u32]>, out: &mut Out) {
+    fn split_larger(&self, r: u32, s: u32, given: Given<'_>, out: &mut Out) {
         let (rn, sn) = (self.node(r), self.node(s));
         let split_r = !rn.is_leaf() && (sn.is_leaf() || rn.area >= sn.area);
         if split_r {
             let [a, b] = rn.kids;
-            self.split(&[(a, s), (b, s)], inherited, out)
+            self.split(&[(a, s), (b, s)], given, out)
         } else {
             let [a, b] = sn.kids;
-            self.split(&[(r, a), (r, b)], inherited, out)
+            self.split(&[(r, a), (r, b)], given, out)
         }
     }
 
     /// Refines `pairs` into `out` in their order, in parallel when they are large.
-    fn split(&self, pairs: &[(u32, u32)], inherited: Option<&[u32]>, out: &mut Out) {
+    fn split(&self, pairs: &[(u32, u32)], given: Given<'_>, out: &mut Out) {
         let size = |&(r, s): &(u32, u32)| {
             let (a, b) = (self.node(r), self.node(s));
             (a.hi - a.lo) as u64 * (b.hi - b.lo) as u64
         };
         if pairs.len() < 2 || pairs.iter().map(size).sum::<u64>() < SERIAL_BELOW {
             for &(r, s) in pairs {
-                self.refine(r, s, inherited, out);
+                self.refine(r, s, given, out);
             }
             return;
         }
@@ -338,12 +362,12 @@ impl<'a> Refiner<'a> {
         let (la, lb) = rayon::join(
             || {
                 let mut v = Out::default();
-                self.split(a, inherited, &mut v);
+                self.split(a, given, &mut v);
                 v
             },
             || {
                 let mut v = Out::default();
-                self.split(b, inherited, &mut v);
+                self.split(b, given, &mut v);
                 v
             },
         );
@@ -351,6 +375,21 @@ impl<'a> Refiner<'a> {
             out.links.extend(part.links);
             out.dropped += part.dropped;
         }
+    }
+}
+
+/// What a pair is handed from the pair it was split from.
+#[derive(Clone, Copy, Default)]
+struct Given<'b> {
+    /// Every face that could block it, when known (`Visibility::blockers_among`).
+    blockers: Option<&'b [u32]>,
+    /// A face that blocked a segment of the pair above (which may hide this one whole).
+    hint: Option<u32>,
+}
+
+impl<'b> Given<'b> {
+    fn new(blockers: Option<&'b [u32]>, hint: Option<u32>) -> Self {
+        Given { blockers, hint }
     }
 }
 

@@ -10,6 +10,7 @@ use super::hierarchy::{Hierarchy, Node};
 use crate::geom::raycast::Occluders;
 use crate::geom::Plane;
 use crate::mesh::elements::Elements;
+use crate::scene::solids::{Occluder, Solid};
 use crate::scene::Face;
 
 /// Blocker lists longer than this go to the BVH per segment instead.
@@ -23,6 +24,9 @@ pub struct Visibility<'a> {
     pub faces: &'a [Face],
     pub el: &'a Elements,
     pub occ: &'a Occluders,
+    /// The scene's convex solids, by the faces `occ` indexes (empty: none known).
+    pub solid_of: &'a [u32],
+    pub occluders: &'a [Occluder],
 }
 
 impl Visibility<'_> {
@@ -85,7 +89,40 @@ impl Visibility<'_> {
     /// without a ray when nothing can be in the way. Also returns the rays cast.
     #[cfg(test)]
     pub fn fraction(&self, r: &Node, s: &Node, rays: u32) -> (f64, u32) {
-        self.fraction_among(r, s, self.blockers(r, s).as_deref(), rays, false)
+        let look = self.fraction_among(r, s, self.blockers(r, s).as_deref(), rays, false);
+        (look.open, look.cast)
+    }
+
+    /// Whether face `id`, or the convex solid it belongs to, blocks every segment between
+    /// `r` and `s` (judged by the triangles of a node of a few or the box of a larger one):
+    /// then no ray need be cast.
+    pub fn covers(&self, id: u32, r: &Node, s: &Node) -> bool {
+        let pts = |n: &Node| -> Vec<DVec3> {
+            if n.hi - n.lo <= 2 {
+                (n.lo..n.hi)
+                    .flat_map(|i| {
+                        let [a, b, c, _] = self.h.corners[i as usize];
+                        [a, b, c].map(|v| self.el.positions[v as usize])
+                    })
+                    .collect()
+            } else {
+                corners(n).to_vec()
+            }
+        };
+        let (a, b) = (pts(r), pts(s));
+        if self.occ.face_covers(id, &a, &b) {
+            return true;
+        }
+        match self
+            .solid_of
+            .get(id as usize)
+            .and_then(|&o| self.occluders.get(o as usize))
+        {
+            Some(Occluder::Solid { solid, .. }) => {
+                solid_covers(solid, &a, &b, self.occ.tolerance())
+            }
+            _ => false,
+        }
     }
 
     /// `fraction`, given the `blockers` between `r` and `s` (`None`: unknown, use the BVH).
@@ -98,9 +135,13 @@ impl Visibility<'_> {
         list: Option<&[u32]>,
         rays: u32,
         until_blocked: bool,
-    ) -> (f64, u32) {
+    ) -> Look {
         if list.is_some_and(|l| l.is_empty()) {
-            return (1.0, 0);
+            return Look {
+                open: 1.0,
+                cast: 0,
+                blocker: None,
+            };
         }
         let skip: Vec<u32> = [r, s]
             .iter()
@@ -112,9 +153,14 @@ impl Visibility<'_> {
         // on faces turned away would be hidden by the box itself, and counting them would
         // dim a link whose light all comes from the faces turned towards the receiver.
         // Candidates are drawn from a longer fixed sequence until `k` such segments are found.
-        let blocked = |a: DVec3, b: DVec3| match list {
-            Some(l) if l.len() <= MAX_LISTED => self.occ.segment_blocked_by(a, b, l),
-            _ => self.occ.segment_blocked_skip(a, b, &skip),
+        let mut first = None;
+        let mut blocked = |a: DVec3, b: DVec3| {
+            let hit = match list {
+                Some(l) if l.len() <= MAX_LISTED => self.occ.segment_blocker_among(a, b, l),
+                _ => self.occ.segment_blocker_skip(a, b, &skip),
+            };
+            first = first.or(hit);
+            hit.is_some()
         };
         // Each segment counts by its own point-to-point factor cosθ·cosθs / d²: the part
         // of a large source next to the receiver carries most of the light, and it is the
@@ -142,7 +188,11 @@ impl Visibility<'_> {
             }
         }
         if counted > 0 && total > 0.0 {
-            return (open / total, counted);
+            return Look {
+                open: open / total,
+                cast: counted,
+                blocker: first,
+            };
         }
         // No pair faces each other (a sliver seen edge-on): every segment counts.
         let open = (0..k)
@@ -152,7 +202,11 @@ impl Visibility<'_> {
                 !blocked(a, b)
             })
             .count();
-        (open as f64 / k as f64, k)
+        Look {
+            open: open as f64 / k as f64,
+            cast: k,
+            blocker: first,
+        }
     }
 
     /// The `i`-th of `k` points on node `n` (in round `round`, which shifts the points within
@@ -186,6 +240,56 @@ impl Visibility<'_> {
         let normal = self.faces[face as usize].plane.n;
         (a * (1.0 - u - v) + b * u + c * v, normal)
     }
+}
+
+/// Whether the convex `solid` hides every segment from a point of the hull of `a` to a point
+/// of the hull of `b`: both lie outside it (each wholly in front of one of its planes: a node
+/// partly buried in it sees out through its inside) and every such segment passes through
+/// its inside. A plane across the axis between the two, through the solid where it can,
+/// separates them; the segments cross it in the hull of the crossings of the segments
+/// between their points (`Occluders::face_covers`), and the solid, being convex, holds that
+/// hull if it holds those crossings, each more than `tol` inside.
+fn solid_covers(solid: &Solid, a: &[DVec3], b: &[DVec3], tol: f64) -> bool {
+    let outside = |p: &[DVec3]| {
+        solid
+            .planes
+            .iter()
+            .any(|pl| p.iter().all(|&x| pl.dist(x) > tol))
+    };
+    if !outside(a) || !outside(b) {
+        return false;
+    }
+    let mean = |p: &[DVec3]| p.iter().copied().sum::<DVec3>() / p.len() as f64;
+    let Some(n) = (mean(b) - mean(a)).try_normalize() else {
+        return false;
+    };
+    let a_top = a
+        .iter()
+        .map(|p| n.dot(*p))
+        .fold(f64::NEG_INFINITY, f64::max);
+    let b_low = b.iter().map(|p| n.dot(*p)).fold(f64::INFINITY, f64::min);
+    if !(b_low - a_top > 2.0 * tol) {
+        return false;
+    }
+    let d = n.dot(solid.centroid).clamp(a_top + tol, b_low - tol);
+    a.iter().all(|&p| {
+        let dp = n.dot(p) - d;
+        b.iter().all(|&q| {
+            let dq = n.dot(q) - d;
+            let x = p + (q - p) * (dp / (dp - dq));
+            solid.planes.iter().all(|pl| pl.dist(x) < -tol)
+        })
+    })
+}
+
+/// What a look along segments between two nodes found.
+pub struct Look {
+    /// Fraction of the light that passes.
+    pub open: f64,
+    /// Segments tested.
+    pub cast: u32,
+    /// A face that blocked one of them.
+    pub blocker: Option<u32>,
 }
 
 fn corners(n: &Node) -> [DVec3; 8] {
@@ -235,6 +339,8 @@ mod test {
             faces: &faces,
             el: &el,
             occ: &occ,
+            solid_of: &[],
+            occluders: &[],
         };
         let [a, b] = h.nodes[0].kids.map(|k| &h.nodes[k as usize]);
         let (f, c) = if a.face == 0 { (a, b) } else { (b, a) };
@@ -258,7 +364,65 @@ mod test {
             faces: &faces2,
             el: &el,
             occ: &occ2,
+            solid_of: &[],
+            occluders: &[],
         };
         assert_eq!(vis2.fraction(f, c, 16), (1.0, 0));
+    }
+
+    #[test]
+    fn a_solid_covers_pairs_outside_it_that_every_segment_crosses() {
+        use crate::scene::json::{LightJson, SceneJson, SettingsJson};
+        use crate::scenes::{cuboid, polygons_mesh};
+        let json = SceneJson {
+            format: "penumbra-scene".into(),
+            version: 1,
+            meshes: vec![polygons_mesh(
+                "Box",
+                cuboid([0.0, 0.0, 0.0], [1.0, 1.0, 1.0], false),
+                Some([0.5; 3]),
+            )],
+            lights: vec![LightJson {
+                name: "Bulb".into(),
+                point: Some([0.0, 0.0, 5.0]),
+                intensity: Some([1.0; 3]),
+                ..Default::default()
+            }],
+            settings: SettingsJson::default(),
+        };
+        let sc = crate::scene::validate(&json).unwrap();
+        let Some(Occluder::Solid { solid, .. }) = sc.occluders.first() else {
+            panic!("the box is one solid");
+        };
+        let occ = Occluders::new(&sc.faces);
+        let tol = occ.tolerance();
+        let tri = |x: f64, y: f64, z: f64, s: f64| {
+            vec![
+                DVec3::new(x, y - s, z - s),
+                DVec3::new(x, y + s, z - s),
+                DVec3::new(x, y, z + s),
+            ]
+        };
+        // Across the box along x.
+        let (a, b) = (tri(-1.0, 0.5, 0.5, 0.2), tri(2.0, 0.5, 0.5, 0.2));
+        assert!(solid_covers(solid, &a, &b, tol));
+        // Wider than the box: a segment passes beside it.
+        assert!(!solid_covers(solid, &tri(-1.0, 0.5, 0.5, 0.9), &b, tol));
+        // One end partly inside: from there a segment sees out without crossing a face.
+        let buried = tri(0.1, 0.5, 0.5, 0.2);
+        assert!(!solid_covers(solid, &buried, &b, tol));
+        // Diagonally through two corners: every segment crosses it, though through two of
+        // its faces, so no one face covers the pair.
+        let (c, d) = (tri(-0.5, -0.5, 0.5, 0.05), tri(1.5, 1.5, 0.5, 0.05));
+        assert!(solid_covers(solid, &c, &d, tol));
+        assert!((0..sc.faces.len() as u32).all(|f| !occ.face_covers(f, &c, &d)));
+        for (p, q) in [(&a, &b), (&c, &d)] {
+            for &x in p.iter() {
+                for &y in q.iter() {
+                    assert!(occ.segment_blocked(x, y));
+                    assert!(occ.segment_blocked((x + p[0]) * 0.5, (y + q[2]) * 0.5));
+                }
+            }
+        }
     }
 }
