@@ -43,21 +43,26 @@ impl<'a> Buried<'a> {
     }
 
     /// Whether element triangle `t` lies inside a solid that its face is not part of: its
-    /// three corners inside every plane of one (a solid is convex, so the whole triangle is).
+    /// three corners inside or on every plane of one (a solid is convex, so the whole
+    /// triangle is) and its centroid inside every one. The mesh follows the lines where one
+    /// solid runs into another, so most buried triangles have a corner on such a line: on
+    /// room-245, 4.7k triangles had all three corners inside and 17.8k more touched the
+    /// line. A triangle lying on one of the solid's faces is a contact (`covered`), not
+    /// buried.
     pub fn buried(&self, el: &Elements, t: u32) -> bool {
         if self.solids.is_empty() {
             return false;
         }
         let corners = el.triangles[t as usize].map(|v| el.positions[v as usize]);
+        let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
         let own = self.scene.face_occluder[el.tri_face[t as usize] as usize];
         let planes = box_planes(&Aabb::from_points(&corners));
         self.tree.any_in_volume(&planes, 0.0, |i| {
             let o = self.solids[i as usize];
             match &self.scene.occluders[o as usize] {
-                Occluder::Solid { solid, .. } if o != own => solid
-                    .planes
-                    .iter()
-                    .all(|p| corners.iter().all(|&c| p.dist(c) < -self.tol)),
+                Occluder::Solid { solid, .. } if o != own => solid.planes.iter().all(|p| {
+                    p.dist(centroid) < -self.tol && corners.iter().all(|&c| p.dist(c) <= self.tol)
+                }),
                 _ => false,
             }
         })
@@ -71,9 +76,8 @@ mod test {
     use crate::scene::json::{LightJson, SceneJson, SettingsJson};
     use crate::scenes::{cuboid, polygons_mesh};
 
-    #[test]
-    fn triangles_inside_another_solid_are_buried() {
-        // A post through a slab: the post's sides between z 0.2 and 0.8 are inside it.
+    /// A post (x, y in 0.4–0.6, z 0–1) through a slab (z 0.2–0.8).
+    fn post_through_slab() -> crate::scene::Scene {
         let post = polygons_mesh(
             "Post",
             cuboid([0.4, 0.4, 0.0], [0.6, 0.6, 1.0], false),
@@ -96,7 +100,13 @@ mod test {
             }],
             settings: SettingsJson::default(),
         };
-        let sc = crate::scene::validate(&json).unwrap();
+        crate::scene::validate(&json).unwrap()
+    }
+
+    #[test]
+    fn triangles_inside_another_solid_are_buried() {
+        // The post's sides between z 0.2 and 0.8 are inside the slab.
+        let sc = post_through_slab();
         let el = grid_elements(&sc.faces, 6);
         let b = Buried::new(&sc, 1e-9);
         let inside = |t: usize| {
@@ -122,6 +132,29 @@ mod test {
         assert!(
             buried > 0 && post_kept > 0,
             "{buried} buried, {post_kept} kept"
+        );
+    }
+
+    #[test]
+    fn triangles_up_to_the_line_where_solids_meet_are_buried() {
+        // Meshed 10 × 10, the elements follow the lines where the post enters and leaves
+        // the slab (z 0.2 and 0.8 on the post, x and y 0.4 and 0.6 on the slab): what is
+        // buried is the post's sides between them and the slab's top and bottom inside the
+        // post, though every one of those triangles at the lines has corners on them.
+        let sc = post_through_slab();
+        let el = grid_elements(&sc.faces, 10);
+        let b = Buried::new(&sc, 1e-9);
+        let area = |t: usize| {
+            let [p, q, r] = el.triangles[t].map(|v| el.positions[v as usize]);
+            0.5 * (q - p).cross(r - p).length()
+        };
+        let buried: f64 = (0..el.triangles.len())
+            .filter(|&t| b.buried(&el, t as u32))
+            .map(area)
+            .sum();
+        assert!(
+            (buried - (4.0 * 0.2 * 0.6 + 2.0 * 0.2 * 0.2)).abs() < 1e-9,
+            "{buried}"
         );
     }
 }
