@@ -148,26 +148,7 @@ impl Occluders {
     /// As [`segment_blocked`](Self::segment_blocked), ignoring the faces in `skip` (say the
     /// shooter's and the receiver's own faces, which cannot block but cost a test).
     pub fn segment_blocked_skip(&self, a: DVec3, b: DVec3, skip: &[u32]) -> bool {
-        let Some(bvh) = &self.wide else { return false };
-        let d = b - a;
-        let len = d.length();
-        if !(len > self.tol) || !len.is_finite() {
-            return false;
-        }
-        let Some(ray) = self.bvh_ray(a, d / len, len).map(wide_ray) else {
-            return false;
-        };
-        !bvh.ray_traverse_miss(ray, |ray, i| {
-            let id = bvh.primitive_indices[i];
-            if !self.ray_meets_box(ray, id) {
-                return f32::INFINITY;
-            }
-            if !skip.contains(&id) && self.face_crosses_segment(id, a, b) {
-                0.0
-            } else {
-                f32::INFINITY
-            }
-        })
+        self.segment_blocker_skip(a, b, skip).is_some()
     }
 
     /// [`segment_blocked_skip`](Self::segment_blocked_skip), with the face that blocks (the
@@ -215,15 +196,15 @@ impl Occluders {
         if f.edges.is_empty() || a.is_empty() || b.is_empty() {
             return false;
         }
-        let da: Vec<f64> = a.iter().map(|&p| f.plane.dist(p)).collect();
-        let db: Vec<f64> = b.iter().map(|&p| f.plane.dist(p)).collect();
-        let side = |d: &[f64], s: f64| d.iter().all(|&x| x * s > self.tol);
-        let s = if da[0] > 0.0 { 1.0 } else { -1.0 };
-        if !side(&da, s) || !side(&db, -s) {
+        let side = if f.plane.dist(a[0]) > 0.0 { 1.0 } else { -1.0 };
+        let beyond = |p: &[DVec3], s: f64| p.iter().all(|&x| f.plane.dist(x) * s > self.tol);
+        if !beyond(a, side) || !beyond(b, -side) {
             return false;
         }
-        a.iter().zip(&da).all(|(&p, &dp)| {
-            b.iter().zip(&db).all(|(&q, &dq)| {
+        a.iter().all(|&p| {
+            let dp = f.plane.dist(p);
+            b.iter().all(|&q| {
+                let dq = f.plane.dist(q);
                 let x = p + (q - p) * (dp / (dp - dq));
                 f.edges.iter().all(|(m, c)| m.dot(x) - c > self.tol)
             })
@@ -233,7 +214,7 @@ impl Occluders {
     /// True if one of `faces` crosses the open segment `a`–`b`: for callers that already
     /// know the few faces that could be in the way.
     pub fn segment_blocked_by(&self, a: DVec3, b: DVec3, faces: &[u32]) -> bool {
-        faces.iter().any(|&f| self.face_crosses_segment(f, a, b))
+        self.segment_blocker_among(a, b, faces).is_some()
     }
 
     /// Signed distance of `p` from face `id`'s plane.

@@ -157,6 +157,24 @@ pub(crate) mod test {
     use crate::geom::polygon::signed_area_2d;
     use crate::geom::{Frame, Plane};
 
+    /// The scene of `meshes` under one point light 5 above the origin: for tests about
+    /// geometry, where the light only has to be valid.
+    pub(crate) fn with_bulb(meshes: Vec<super::json::MeshJson>) -> super::Scene {
+        super::validate(&super::json::SceneJson {
+            format: "penumbra-scene".into(),
+            version: 1,
+            meshes,
+            lights: vec![super::json::LightJson {
+                name: "Bulb".into(),
+                point: Some([0.0, 0.0, 5.0]),
+                intensity: Some([1.0; 3]),
+                ..Default::default()
+            }],
+            settings: super::json::SettingsJson::default(),
+        })
+        .unwrap()
+    }
+
     /// A face from counter-clockwise (seen from the front) vertices.
     pub(crate) fn face(verts: &[DVec3], albedo: DVec3, emission: DVec3) -> Face {
         let plane = Plane::from_polygon(verts).expect("face has area");

@@ -124,7 +124,7 @@ pub fn burial(scene: &Scene, eps: f64) -> Burial {
 #[cfg(test)]
 mod test {
     use super::*;
-    use crate::scene::json::{LightJson, MeshJson, SceneJson, SettingsJson};
+    use crate::scene::json::MeshJson;
 
     fn cuboid(lo: [f64; 3], hi: [f64; 3]) -> MeshJson {
         let p = |i: usize| {
@@ -155,19 +155,7 @@ mod test {
 
     /// One mesh per box, so that equal boxes stay two solids.
     fn scene(boxes: &[([f64; 3], [f64; 3])]) -> Scene {
-        let json = SceneJson {
-            format: "penumbra-scene".into(),
-            version: 1,
-            meshes: boxes.iter().map(|(lo, hi)| cuboid(*lo, *hi)).collect(),
-            lights: vec![LightJson {
-                name: "Bulb".into(),
-                point: Some([0.0, 0.0, 5.0]),
-                intensity: Some([1.0; 3]),
-                ..Default::default()
-            }],
-            settings: SettingsJson::default(),
-        };
-        crate::scene::validate(&json).unwrap()
+        crate::scene::test::with_bulb(boxes.iter().map(|(lo, hi)| cuboid(*lo, *hi)).collect())
     }
 
     #[test]

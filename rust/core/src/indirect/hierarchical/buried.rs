@@ -73,7 +73,6 @@ impl<'a> Buried<'a> {
 mod test {
     use super::*;
     use crate::indirect::patches::test::grid_elements;
-    use crate::scene::json::{LightJson, SceneJson, SettingsJson};
     use crate::scenes::{cuboid, polygons_mesh};
 
     /// A post (x, y in 0.4–0.6, z 0–1) through a slab (z 0.2–0.8).
@@ -88,19 +87,7 @@ mod test {
             cuboid([0.0, 0.0, 0.2], [1.0, 1.0, 0.8], false),
             Some([0.5; 3]),
         );
-        let json = SceneJson {
-            format: "penumbra-scene".into(),
-            version: 1,
-            meshes: vec![post, slab],
-            lights: vec![LightJson {
-                name: "Bulb".into(),
-                point: Some([0.0, 0.0, 5.0]),
-                intensity: Some([1.0; 3]),
-                ..Default::default()
-            }],
-            settings: SettingsJson::default(),
-        };
-        crate::scene::validate(&json).unwrap()
+        crate::scene::test::with_bulb(vec![post, slab])
     }
 
     #[test]

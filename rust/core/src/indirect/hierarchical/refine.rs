@@ -254,8 +254,7 @@ impl<'a> Refiner<'a> {
         // rays can miss a small blocker near one end (a leg under a seat).
         let listed = blockers.as_ref().is_some_and(|l| !l.is_empty());
         if listed && !both_leaves && power > self.eps / PARTIAL && !self.over_budget() {
-            let hint = given.hint;
-            return self.split_larger(r, s, Given::new(blockers.as_deref(), hint), out);
+            return self.split_larger(r, s, Given::new(blockers.as_deref(), given.hint), out);
         }
         // Something may be in the way of a link carrying much: sample it more densely.
         let rays = if error > self.eps / 4.0 { self.rays } else { 4 };

@@ -97,20 +97,25 @@ impl Visibility<'_> {
     /// `r` and `s` (judged by the triangles of a node of a few or the box of a larger one):
     /// then no ray need be cast.
     pub fn covers(&self, id: u32, r: &Node, s: &Node) -> bool {
-        let pts = |n: &Node| -> Vec<DVec3> {
+        // Up to two triangles' corners, or a box's: on the stack, as this runs for every
+        // pair under one that a face hid in part.
+        let pts = |n: &Node| -> ([DVec3; 8], usize) {
             if n.hi - n.lo <= 2 {
-                (n.lo..n.hi)
-                    .flat_map(|i| {
-                        let [a, b, c, _] = self.h.corners[i as usize];
-                        [a, b, c].map(|v| self.el.positions[v as usize])
-                    })
-                    .collect()
+                let mut out = [DVec3::ZERO; 8];
+                for (k, i) in (n.lo..n.hi).enumerate() {
+                    let [a, b, c, _] = self.h.corners[i as usize];
+                    for (j, v) in [a, b, c].into_iter().enumerate() {
+                        out[3 * k + j] = self.el.positions[v as usize];
+                    }
+                }
+                (out, 3 * (n.hi - n.lo) as usize)
             } else {
-                corners(n).to_vec()
+                (corners(n), 8)
             }
         };
-        let (a, b) = (pts(r), pts(s));
-        if self.occ.face_covers(id, &a, &b) {
+        let ((pa, na), (pb, nb)) = (pts(r), pts(s));
+        let (a, b) = (&pa[..na], &pb[..nb]);
+        if self.occ.face_covers(id, a, b) {
             return true;
         }
         match self
@@ -118,9 +123,7 @@ impl Visibility<'_> {
             .get(id as usize)
             .and_then(|&o| self.occluders.get(o as usize))
         {
-            Some(Occluder::Solid { solid, .. }) => {
-                solid_covers(solid, &a, &b, self.occ.tolerance())
-            }
+            Some(Occluder::Solid { solid, .. }) => solid_covers(solid, a, b, self.occ.tolerance()),
             _ => false,
         }
     }
@@ -372,25 +375,12 @@ mod test {
 
     #[test]
     fn a_solid_covers_pairs_outside_it_that_every_segment_crosses() {
-        use crate::scene::json::{LightJson, SceneJson, SettingsJson};
         use crate::scenes::{cuboid, polygons_mesh};
-        let json = SceneJson {
-            format: "penumbra-scene".into(),
-            version: 1,
-            meshes: vec![polygons_mesh(
-                "Box",
-                cuboid([0.0, 0.0, 0.0], [1.0, 1.0, 1.0], false),
-                Some([0.5; 3]),
-            )],
-            lights: vec![LightJson {
-                name: "Bulb".into(),
-                point: Some([0.0, 0.0, 5.0]),
-                intensity: Some([1.0; 3]),
-                ..Default::default()
-            }],
-            settings: SettingsJson::default(),
-        };
-        let sc = crate::scene::validate(&json).unwrap();
+        let sc = crate::scene::test::with_bulb(vec![polygons_mesh(
+            "Box",
+            cuboid([0.0, 0.0, 0.0], [1.0, 1.0, 1.0], false),
+            Some([0.5; 3]),
+        )]);
         let Some(Occluder::Solid { solid, .. }) = sc.occluders.first() else {
             panic!("the box is one solid");
         };
