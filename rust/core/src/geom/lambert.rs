@@ -78,13 +78,65 @@ pub fn edges_irradiance(p: DVec3, n: DVec3, edges: &[[DVec3; 2]]) -> Option<f64>
         back |= h < -1e-9 * r.length();
     }
     if back {
-        return if front { None } else { Some(0.0) };
+        return if front {
+            straddling_edges_irradiance(p, n, edges)
+        } else {
+            Some(0.0)
+        };
     }
     let s: f64 = edges
         .iter()
         .map(|[a, b]| edge_term(n, *a - p, *b - *a, *b - p))
         .sum();
     Some(0.5 * s.abs())
+}
+
+/// `edges_irradiance` of a planar region that straddles `p`'s plane, without tracing its
+/// loops. Clipping a loop to the half-space in front of `p` keeps the parts of its edges
+/// there and adds segments along the line where the region's plane meets `p`'s, each from
+/// where the loop leaves the half-space to where it comes back. Such a segment lies in `p`'s
+/// plane, so its term is the angle it turns through about `n`: the difference of the
+/// angles of its ends seen from `p`, measured from any one point of that line (a line seen
+/// from a point off it spans under π, so the difference never wraps). The added segments'
+/// terms thus sum to the angles of the points where edges come back less those where they
+/// leave, edge by edge. `None` where `p` lies on that line (the region is seen edge-on
+/// from `p`: let the caller clip).
+fn straddling_edges_irradiance(p: DVec3, n: DVec3, edges: &[[DVec3; 2]]) -> Option<f64> {
+    let mut sum = 0.0;
+    let mut from: Option<DVec3> = None;
+    let mut turns = 0.0;
+    for [a, b] in edges {
+        let (ra, rb) = (*a - p, *b - p);
+        let (ha, hb) = (ra.dot(n), rb.dot(n));
+        let (fa, fb) = (ha > 0.0, hb > 0.0);
+        if fa && fb {
+            sum += edge_term(n, ra, *b - *a, rb);
+            continue;
+        }
+        if !fa && !fb {
+            continue;
+        }
+        // Where the edge meets the plane, from its front end (kept exact there).
+        let (rf, rk, hf, hk) = if fa {
+            (ra, rb, ha, hb)
+        } else {
+            (rb, ra, hb, ha)
+        };
+        let x = rf + (rk - rf) * (hf / (hf - hk));
+        let x = x - n * x.dot(n);
+        if fa {
+            sum += edge_term(n, ra, x - ra, x);
+        } else {
+            sum += edge_term(n, x, rb - x, rb);
+        }
+        let o = *from.get_or_insert(x);
+        if !(o.length() > 0.0) {
+            return None;
+        }
+        let angle = n.dot(o.cross(x)).atan2(o.dot(x));
+        turns += if fa { -angle } else { angle };
+    }
+    Some(0.5 * (sum + turns).abs())
 }
 
 /// Signed `Σ θ_i (n · Γ_i)` over the part of a closed contour in front of `p`.
@@ -344,6 +396,51 @@ pub(crate) mod test {
         let s = 1e8;
         let e = polygon_irradiance(DVec3::ZERO, DVec3::Z, &rect_z(-s, s, -s, s, 1.0));
         assert!((e - PI).abs() < 1e-6);
+    }
+
+    #[test]
+    fn straddling_region_as_edges_matches_its_clipped_loops() {
+        // Regions across the receiver's plane, given as unordered edges of several loops (a
+        // square with a square hole, and a separate triangle), against clipping each loop.
+        use crate::geom::hash::{mix, unit};
+        let mut seed = 7u64;
+        let mut r = || {
+            seed = mix(seed);
+            unit(seed) * 2.0 - 1.0
+        };
+        let mut straddling = 0;
+        for _ in 0..200 {
+            let p = DVec3::new(r(), r(), r()) * 0.3;
+            let n = DVec3::new(r(), r(), 1.0).normalize();
+            let o = DVec3::new(r(), r(), r()) * 0.5;
+            let u = DVec3::new(1.0, r() * 0.3, r()).normalize();
+            let w = DVec3::new(r() * 0.3, r(), 1.0).cross(u).normalize();
+            let at = |x: f64, y: f64| o + u * x + w * y;
+            let outer = vec![at(-1.0, -1.0), at(1.0, -1.0), at(1.0, 1.0), at(-1.0, 1.0)];
+            let hole = vec![at(-0.4, -0.3), at(-0.4, 0.5), at(0.2, 0.5), at(0.2, -0.3)];
+            let tri = vec![at(1.5, 0.0), at(2.5, 0.2), at(1.8, 1.4)];
+            let loops = [outer, hole, tri];
+            let mut edges: Vec<[DVec3; 2]> = loops
+                .iter()
+                .flat_map(|l| (0..l.len()).map(move |i| [l[i], l[(i + 1) % l.len()]]))
+                .collect();
+            edges.reverse();
+            let want = contours_irradiance(p, n, &loops);
+            let got = edges_irradiance(p, n, &edges).unwrap();
+            assert!(
+                (got - want).abs() <= 1e-12 + 1e-10 * want,
+                "{got} vs {want}"
+            );
+            let h: Vec<f64> = edges.iter().map(|e| (e[0] - p).dot(n)).collect();
+            straddling += (h.iter().any(|&x| x > 0.0) && h.iter().any(|&x| x < 0.0)) as u32;
+        }
+        assert!(straddling > 100, "{straddling}");
+        // A wall standing across a floor point's horizon, the case the final gather meets:
+        // half of it below the plane.
+        let wall = rect_x(1.0, -1.0, 1.0, -1.0, 1.0);
+        let edges: Vec<[DVec3; 2]> = (0..4).map(|i| [wall[i], wall[(i + 1) % 4]]).collect();
+        let got = edges_irradiance(DVec3::ZERO, DVec3::Z, &edges).unwrap();
+        assert!(rel_err(got, 2.0 * perpendicular(1.0, 1.0, 1.0)) < 1e-12);
     }
 
     #[test]
