@@ -244,17 +244,21 @@ impl<'a> Refiner<'a> {
         }
         // A faint pair is never split, so its shaft list would only spare it a few rays;
         // in clutter most shaft queries give up past their cap anyway (room-245: 2.1M of
-        // 2.9M), and the query costs more than the rays.
+        // 2.9M), and the query costs more than the rays. Nor is a pair queried whose shaft
+        // lies in that of a pair above that gave up: the candidates thin out slowly as the
+        // nodes halve, and those queries were a third of room-8328's refinement.
         let blockers = match given.blockers {
             Some(l) => Some(self.vis.blockers_among(rn, sn, l)),
-            None if faint => None,
+            None if faint || given.crowded => None,
             None => self.vis.blockers(rn, sn),
         };
+        let crowded = given.crowded || (!faint && given.blockers.is_none() && blockers.is_none());
         // A shaft with something in it is treated as partly blocked without a ray: a few
         // rays can miss a small blocker near one end (a leg under a seat).
         let listed = blockers.as_ref().is_some_and(|l| !l.is_empty());
         if listed && !both_leaves && power > self.eps / PARTIAL && !self.over_budget() {
-            return self.split_larger(r, s, Given::new(blockers.as_deref(), given.hint), out);
+            let given = Given::new(blockers.as_deref(), given.hint, false);
+            return self.split_larger(r, s, given, out);
         }
         // Something may be in the way of a link carrying much: sample it more densely.
         let rays = if error > self.eps / 4.0 { self.rays } else { 4 };
@@ -287,7 +291,7 @@ impl<'a> Refiner<'a> {
         // Partly hidden: the shadow varies over the receiver, and a mean over it would
         // light its dark part (the seat right above a leg). Split the receiver first.
         if v < 1.0 && (v > 0.0 || cast > 0) && !covered && splits && !self.over_budget() {
-            let given = Given::new(blockers.as_deref(), look.blocker.or(given.hint));
+            let given = Given::new(blockers.as_deref(), look.blocker.or(given.hint), crowded);
             return if rn.is_leaf() {
                 self.split_larger(r, s, given, out)
             } else {
@@ -384,11 +388,17 @@ struct Given<'b> {
     blockers: Option<&'b [u32]>,
     /// A face that blocked a segment of the pair above (which may hide this one whole).
     hint: Option<u32>,
+    /// The shaft query of a pair above gave up (`Visibility::blockers` past its cap).
+    crowded: bool,
 }
 
 impl<'b> Given<'b> {
-    fn new(blockers: Option<&'b [u32]>, hint: Option<u32>) -> Self {
-        Given { blockers, hint }
+    fn new(blockers: Option<&'b [u32]>, hint: Option<u32>, crowded: bool) -> Self {
+        Given {
+            blockers,
+            hint,
+            crowded,
+        }
     }
 }
 
