@@ -130,10 +130,13 @@ fn straddling_edges_irradiance(p: DVec3, n: DVec3, edges: &[[DVec3; 2]]) -> Opti
             sum += edge_term(n, x, rb - x, rb);
         }
         let o = *from.get_or_insert(x);
-        if !(o.length() > 0.0) {
+        let c = o.cross(x);
+        // Two crossings on opposite sides of p: the line runs through p.
+        if !(o.length() > 0.0) || (c.length() <= 1e-12 * o.length() * x.length() && o.dot(x) < 0.0)
+        {
             return None;
         }
-        let angle = n.dot(o.cross(x)).atan2(o.dot(x));
+        let angle = n.dot(c).atan2(o.dot(x));
         turns += if fa { -angle } else { angle };
     }
     Some(0.5 * (sum + turns).abs())
@@ -441,6 +444,11 @@ pub(crate) mod test {
         let edges: Vec<[DVec3; 2]> = (0..4).map(|i| [wall[i], wall[(i + 1) % 4]]).collect();
         let got = edges_irradiance(DVec3::ZERO, DVec3::Z, &edges).unwrap();
         assert!(rel_err(got, 2.0 * perpendicular(1.0, 1.0, 1.0)) < 1e-12);
+        // The point on the wall's plane, inside it: seen edge-on, the wall gives nothing,
+        // and the crossings on either side of the point must not add half a turn.
+        let edges: Vec<[DVec3; 2]> = (0..4).map(|i| [wall[i], wall[(i + 1) % 4]]).collect();
+        let p = DVec3::new(1.0, 0.0, 0.0);
+        assert!(edges_irradiance(p, DVec3::Z, &edges).is_none_or(|e| e.abs() < 1e-12));
     }
 
     #[test]
