@@ -446,7 +446,6 @@ pub(crate) mod test {
         assert!(rel_err(got, 2.0 * perpendicular(1.0, 1.0, 1.0)) < 1e-12);
         // The point on the wall's plane, inside it: seen edge-on, the wall gives nothing,
         // and the crossings on either side of the point must not add half a turn.
-        let edges: Vec<[DVec3; 2]> = (0..4).map(|i| [wall[i], wall[(i + 1) % 4]]).collect();
         let p = DVec3::new(1.0, 0.0, 0.0);
         assert!(edges_irradiance(p, DVec3::Z, &edges).is_none_or(|e| e.abs() < 1e-12));
     }
