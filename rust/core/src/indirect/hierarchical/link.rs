@@ -145,6 +145,32 @@ impl<'a> Ends<'a> {
             clear,
         }
     }
+
+    /// The link between two planar nodes with visibility `v` and the factor at the
+    /// receiver's centroid: for the parts of a faint near pair (`refine`), whose light is
+    /// too little for the mean over the receiver or the exact pair.
+    pub fn centroid_link(
+        &self,
+        h: &Hierarchy,
+        el: &Elements,
+        receiver: u32,
+        source: u32,
+        v: f64,
+    ) -> Link {
+        let (Some(nr), Some(ns)) = (self.nr, self.ns) else {
+            return self.link(h, el, receiver, source, v, false, false);
+        };
+        let u = self.offset().normalize_or(DVec3::Z);
+        let k = planar_factor(h, el, self.r.centroid, nr, self.s, ns, POINT_DEPTH);
+        Link {
+            receiver,
+            source,
+            k: (k * v) as f32,
+            u: u.as_vec3(),
+            v: v as f32,
+            clear: false,
+        }
+    }
 }
 
 /// The coefficient and direction of a link from the point `p` (normal `n`) to node `s`,

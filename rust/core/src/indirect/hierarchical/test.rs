@@ -126,6 +126,160 @@ fn step_emitter_a_few_mm_over_a_receiver() {
 }
 
 #[test]
+fn box_side_beside_a_glowing_box_sees_its_face_not_a_cluster() {
+    // Regression: room-78's boxes standing a few mm apart on a table got 25–40 % too little
+    // light on their sides. A pair of objects in each other's near field that carried little
+    // against the scene's light was linked as two clusters, and a cluster's link gives all
+    // of its faces one direction and one distance. Two black boxes 0.1 across, 5 mm apart;
+    // the second one's side facing the first glows (Le = 1), and a bright panel far behind
+    // the first box (emitting from both sides, as in Cycles) makes their pair faint. A point
+    // on the first box's facing side gets π·Le·F to the glowing side, a parallel rectangle
+    // 5 mm away, in closed form (it cannot see the panel, behind its plane).
+    let (g, a) = (0.005, 0.05);
+    let c = |x: f64, y: f64, z: f64| v(x, y, z);
+    let (x, y, z) = (DVec3::X * a, DVec3::Y * a, DVec3::Z * a);
+    let black = DVec3::ZERO;
+    let box_faces = |x0: f64, glow: DVec3| {
+        vec![
+            quad(c(x0 + 2.0 * a, 0.0, a), y, z, 0.0, black),
+            quad(c(x0, 0.0, a), z, y, 0.0, glow),
+            quad(c(x0 + a, a, a), z, x, 0.0, black),
+            quad(c(x0 + a, -a, a), x, z, 0.0, black),
+            quad(c(x0 + a, 0.0, 2.0 * a), x, y, 0.0, black),
+        ]
+    };
+    let mut faces = box_faces(-2.0 * a, black);
+    faces.extend(box_faces(g, DVec3::ONE));
+    faces.push(quad(
+        v(-3.0, 0.0, a),
+        DVec3::Z * 0.25,
+        DVec3::Y * 0.25,
+        0.0,
+        DVec3::splat(1e6),
+    ));
+    let sc = scene(faces, |s| s.convergence = 1e-3);
+    let el = sized_elements(&sc.faces, 0.02);
+    let occ = Occluders::new(&sc.faces);
+    let direct = vec![DVec3::ZERO; el.positions.len()];
+    let r = indirect(&sc, &el, &direct, &occ, &Progress::new()).unwrap();
+    let mut checked = 0;
+    for (i, p) in el.positions.iter().enumerate() {
+        // The first box's side facing +x, inside its border.
+        if el.vertex_face[i] != 0 || p.y.abs() > 0.8 * a || (p.z - a).abs() > 0.8 * a {
+            continue;
+        }
+        let want = rect_factor(-a - p.y, a - p.y, -p.z, 2.0 * a - p.z, g);
+        let got = r.irradiance[i].x / PI;
+        assert!((got - want).abs() < 0.01 * want, "{p}: {got} vs {want}");
+        checked += 1;
+    }
+    assert!(checked >= 9, "{checked}");
+}
+
+#[test]
+fn faint_near_light_keeps_its_shape_for_the_next_bounce() {
+    // Regression: a faint pair in each other's near field was linked whole, so its receiver
+    // took one irradiance, and sent on the mean of a light that varies across it (room-78:
+    // box sides by the table top, lit mostly by the light that the boxes and the table send
+    // each other). A grey plate (ρ = 0.5) 0.2 × 0.1 at z = 0; 5 mm above it, facing down, a
+    // glowing plate (Le = 1) over its x < 0 half and a black one over its x > 0 half (the
+    // grey plate is cut there, as the discontinuity mesh would cut it); a panel 100 times
+    // as bright far away, edge-on to all three, makes their pairs faint. The black plate
+    // gets only what the grey one reflects: E(y) = ∫ ρ·π·Le·F(x) · g² / (π·|x − y|⁴) dx over
+    // the grey plate, F(x) its factor to the glowing plate (closed form), the integral by
+    // the midpoint rule on a 0.25 mm grid.
+    let (g, rho) = (0.005, 0.5);
+    let faces = vec![
+        quad(
+            v(-0.05, 0.0, 0.0),
+            DVec3::X * 0.05,
+            DVec3::Y * 0.05,
+            rho,
+            DVec3::ZERO,
+        ),
+        quad(
+            v(0.05, 0.0, 0.0),
+            DVec3::X * 0.05,
+            DVec3::Y * 0.05,
+            rho,
+            DVec3::ZERO,
+        ),
+        quad(
+            v(-0.05, 0.0, g),
+            DVec3::Y * 0.05,
+            DVec3::X * 0.05,
+            0.0,
+            DVec3::ONE,
+        ),
+        quad(
+            v(0.05, 0.0, g),
+            DVec3::Y * 0.05,
+            DVec3::X * 0.05,
+            0.0,
+            DVec3::ZERO,
+        ),
+        quad(
+            v(30.0, 0.0, 0.5 * g),
+            DVec3::X * 0.25,
+            DVec3::Y * 0.25,
+            0.0,
+            DVec3::splat(100.0),
+        ),
+    ];
+    // Leaves of single elements: what is tested is the links' resolution, not the leaves'.
+    let sc = scene(faces, |s| {
+        s.convergence = 1e-3;
+        s.patch_size = 0.004;
+    });
+    let el = sized_elements(&sc.faces, 0.004);
+    let occ = Occluders::new(&sc.faces);
+    let direct = vec![DVec3::ZERO; el.positions.len()];
+    let r = indirect(&sc, &el, &direct, &occ, &Progress::new()).unwrap();
+    let step = 2.5e-4;
+    let grid: Vec<(f64, f64, f64)> = (0..800)
+        .flat_map(|i| {
+            (0..400).map(move |j| {
+                (
+                    -0.1 + (i as f64 + 0.5) * step,
+                    -0.05 + (j as f64 + 0.5) * step,
+                )
+            })
+        })
+        .map(|(x, y)| {
+            (
+                x,
+                y,
+                rho * rect_factor(-0.1 - x, -x, -0.05 - y, 0.05 - y, g),
+            )
+        })
+        .collect();
+    let (mut checked, mut worst, mut top) = (0, 0.0f64, 0.0f64);
+    for (i, p) in el.positions.iter().enumerate() {
+        if el.vertex_face[i] != 3 || p.x < 0.01 || p.x > 0.09 || p.y.abs() > 0.04 {
+            continue;
+        }
+        let want: f64 = grid
+            .iter()
+            .map(|&(x, y, b)| {
+                let r2 = (x - p.x).powi(2) + (y - p.y).powi(2) + g * g;
+                b * g * g / (PI * r2 * r2)
+            })
+            .sum::<f64>()
+            * step
+            * step;
+        let got = r.irradiance[i].x / PI;
+        worst = worst.max((got - want).abs());
+        top = top.max(want);
+        checked += 1;
+    }
+    assert!(checked >= 100, "{checked}");
+    // Against the brightest point (by the cut, 5 mm from the glowing plate's edge), since
+    // the light falls a hundredfold across the plate: 1.5 % of it here, 30 % with faint
+    // near pairs linked whole.
+    assert!(worst < 0.03 * top, "{worst} of {top}");
+}
+
+#[test]
 #[ignore = "open (issue 11): the hierarchical solver gives the seat above the leg 0.53 against \
             0.71 in the open, and the leg top 0.58; the final gather at the vertices now sees the \
             leg (0.80 before), but the solve's leaves are groups of elements, and one straddling \
@@ -247,6 +401,9 @@ fn floor_under_a_table_sees_no_ceiling_through_it() {
         let want = seen(*p);
         let got = r.irradiance[i].x / PI;
         worst = worst.max((got / want - 1.0).abs());
+        if (got / want - 1.0).abs() > 0.03 {
+            eprintln!("{p}: {got} vs {want}");
+        }
         sum += got / want;
         count += 1;
     }
