@@ -41,6 +41,18 @@ pub struct Link {
     pub clear: bool,
 }
 
+/// How a link between two planar nodes takes its factor.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub enum Factor {
+    /// Exact for near leaves, the mean over points of a near receiver, second order for far.
+    Sampled,
+    /// As `Sampled`, but the factor at a near receiver's centroid (a link carrying little).
+    Near,
+    /// The factor at the receiver's centroid: for the parts of a faint near pair
+    /// (`refine`), whose light is too little for a mean over the receiver or the exact pair.
+    Centroid,
+}
+
 /// What a link needs to know of its two ends.
 pub struct Ends<'a> {
     pub r: &'a Node,
@@ -87,7 +99,8 @@ impl<'a> Ends<'a> {
     }
 
     /// The link with visibility `v` (fraction of the source seen from the receiver), and
-    /// `clear` when nothing lies in the shaft between the two.
+    /// `clear` when nothing lies in the shaft between the two; `factor` says how a planar
+    /// pair's factor is taken.
     #[allow(clippy::too_many_arguments)]
     pub fn link(
         &self,
@@ -97,7 +110,7 @@ impl<'a> Ends<'a> {
         source: u32,
         v: f64,
         clear: bool,
-        sample: bool,
+        factor: Factor,
     ) -> Link {
         let pi = std::f64::consts::PI;
         let d = self.offset();
@@ -105,6 +118,9 @@ impl<'a> Ends<'a> {
         let u = d.normalize_or(DVec3::Z);
         let soft = pi * d2 + seen_area(self.s);
         let k = match (self.nr, self.ns) {
+            (Some(nr), Some(ns)) if factor == Factor::Centroid => {
+                planar_factor(h, el, self.r.centroid, nr, self.s, ns, POINT_DEPTH)
+            }
             (Some(nr), Some(ns)) => {
                 let near = self.r.radius() + self.s.radius() > RECEIVER_NEAR * d2.sqrt();
                 if let Some(k) = near
@@ -112,7 +128,7 @@ impl<'a> Ends<'a> {
                     .flatten()
                 {
                     k
-                } else if near && sample {
+                } else if near && factor == Factor::Sampled {
                     // The factor varies over a receiver close to its source (two leaves
                     // meeting at a corner): its mean over points spread on the receiver,
                     // each point's taken exactly, keeps the light the receiver gets.
@@ -143,32 +159,6 @@ impl<'a> Ends<'a> {
             u: u.as_vec3(),
             v: v as f32,
             clear,
-        }
-    }
-
-    /// The link between two planar nodes with visibility `v` and the factor at the
-    /// receiver's centroid: for the parts of a faint near pair (`refine`), whose light is
-    /// too little for the mean over the receiver or the exact pair.
-    pub fn centroid_link(
-        &self,
-        h: &Hierarchy,
-        el: &Elements,
-        receiver: u32,
-        source: u32,
-        v: f64,
-    ) -> Link {
-        let (Some(nr), Some(ns)) = (self.nr, self.ns) else {
-            return self.link(h, el, receiver, source, v, false, false);
-        };
-        let u = self.offset().normalize_or(DVec3::Z);
-        let k = planar_factor(h, el, self.r.centroid, nr, self.s, ns, POINT_DEPTH);
-        Link {
-            receiver,
-            source,
-            k: (k * v) as f32,
-            u: u.as_vec3(),
-            v: v as f32,
-            clear: false,
         }
     }
 }
@@ -291,13 +281,13 @@ mod test {
         let faces = [bottom, top];
         let (h, el, r, s) = face_nodes(&faces);
         let ends = Ends::new(&h, &faces, r, s);
-        let l = ends.link(&h, &el, r, s, 1.0, true, true);
+        let l = ends.link(&h, &el, r, s, 1.0, true, Factor::Sampled);
         // Exact: a point under a small square's centre: F ≈ A/(π·h²).
         let want = 0.01 / (std::f64::consts::PI * 4.0);
         assert!((l.k as f64 / want - 1.0).abs() < 2e-3, "{} vs {want}", l.k);
         assert!(ends.factor_bound() >= l.k as f64 * 0.999);
         // Half visible: half the coefficient.
-        let half = ends.link(&h, &el, r, s, 0.5, false, true);
+        let half = ends.link(&h, &el, r, s, 0.5, false, Factor::Sampled);
         assert!((half.k * 2.0 - l.k).abs() < 1e-9);
         assert!((l.u - Vec3::Z).length() < 1e-6);
     }
@@ -368,7 +358,7 @@ mod test {
         let (h, el, r, s) = face_nodes(&faces);
         assert!(!h.nodes[r as usize].is_leaf() && !h.nodes[s as usize].is_leaf());
         let ends = Ends::new(&h, &faces, r, s);
-        let k = ends.link(&h, &el, r, s, 1.0, true, false).k;
+        let k = ends.link(&h, &el, r, s, 1.0, true, Factor::Near).k;
         // From the receiver's centre the other plate fills nearly all the hemisphere.
         assert!(k > 0.98 && k <= 1.0, "{k}");
     }

@@ -24,7 +24,7 @@
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use super::hierarchy::Node;
-use super::link::{Ends, Link};
+use super::link::{Ends, Factor, Link};
 use super::visibility::Visibility;
 use crate::progress::Progress;
 
@@ -214,7 +214,7 @@ impl<'a> Refiner<'a> {
                 return self.split_larger(r, s, given, out);
             }
             self.settle(rn, sn);
-            let link = ends.centroid_link(h, self.vis.el, r, s, v as f64);
+            let link = ends.link(h, self.vis.el, r, s, v as f64, false, Factor::Centroid);
             if link.k > 0.0 || ends.factor_bound() > 0.0 {
                 self.push(out, link);
             }
@@ -338,7 +338,8 @@ impl<'a> Refiner<'a> {
             return;
         }
         let clear = blockers.as_ref().is_some_and(|l| l.is_empty());
-        let link = ends.link(h, self.vis.el, r, s, v, clear, !faint);
+        let factor = if faint { Factor::Near } else { Factor::Sampled };
+        let link = ends.link(h, self.vis.el, r, s, v, clear, factor);
         if link.k > 0.0 || ends.factor_bound() > 0.0 {
             self.push(out, link);
         }
