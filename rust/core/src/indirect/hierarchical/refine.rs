@@ -215,10 +215,7 @@ impl<'a> Refiner<'a> {
             }
             self.settle(rn, sn);
             let link = ends.link(h, self.vis.el, r, s, v as f64, false, Factor::Centroid);
-            if link.k > 0.0 || ends.factor_bound() > 0.0 {
-                self.push(out, link);
-            }
-            return;
+            return self.push(out, link, &ends);
         }
         // The point and disc estimates are off by about (size / distance)²: the error the
         // link would make, not the light it carries, decides.
@@ -340,13 +337,15 @@ impl<'a> Refiner<'a> {
         let clear = blockers.as_ref().is_some_and(|l| l.is_empty());
         let factor = if faint { Factor::Near } else { Factor::Sampled };
         let link = ends.link(h, self.vis.el, r, s, v, clear, factor);
-        if link.k > 0.0 || ends.factor_bound() > 0.0 {
-            self.push(out, link);
-        }
+        self.push(out, link, &ends);
     }
 
-    /// Keeps `link`, and reports progress now and then.
-    fn push(&self, out: &mut Out, link: Link) {
+    /// Keeps `link` unless nothing can pass between its `ends`, and reports progress now
+    /// and then.
+    fn push(&self, out: &mut Out, link: Link, ends: &Ends<'_>) {
+        if !(link.k > 0.0 || ends.factor_bound() > 0.0) {
+            return;
+        }
         out.links.push(link);
         let n = self.links.fetch_add(1, Ordering::Relaxed) + 1;
         if n % 4096 == 0 {
