@@ -611,3 +611,70 @@ fn feet_stay_in_the_mesh_for_indirect_light() {
     }
     assert!(on_foot > 8);
 }
+
+#[test]
+fn unlit_side_is_cut_where_a_neighbour_enters_it() {
+    // B passes through A's -x side, which faces away from the only light: no light's shadow
+    // volumes reach that side, yet bounced light does, and none inside B. Its elements must
+    // follow the cut, or the few that span the whole side take the dark of their corners
+    // inside B (room-245: 0.09 where Cycles gives 0.90).
+    let floor = mesh("Floor", vec![quad([0.0, 0.0, 0.0], 2.0, 2.0, true)]);
+    let a = mesh("A", cuboid([-0.3, -0.2, 0.0], [0.1, 0.2, 0.4]));
+    let b = mesh("B", cuboid([-0.5, -0.1, 0.0], [-0.2, 0.1, 0.2]));
+    let settings = SettingsJson {
+        element_size: Some(0.25),
+        convergence: Some(0.05),
+        ..Default::default()
+    };
+    let s = scene(vec![floor, a, b], vec![square_light()], settings);
+    let side = polygons(&s)
+        .into_iter()
+        .find(|(m, _, v)| *m == 1 && v.iter().all(|p| (p.x + 0.3).abs() < 1e-12))
+        .map(|(_, p, _)| p as u32)
+        .expect("A's -x side");
+    let baked = bake(&s);
+    let am = &baked.meshes[1];
+    // +1 outside B, -1 inside, 0 on its boundary (within A's -x plane).
+    let where_ = |p: [f64; 3]| -> i32 {
+        let d = (0.1 - p[1].abs()).min(0.2 - p[2]);
+        if d > 1e-9 {
+            -1
+        } else if d < -1e-9 {
+            1
+        } else {
+            0
+        }
+    };
+    let (mut outside, mut inside) = (0, 0);
+    for (t, tri) in am.triangles.iter().enumerate() {
+        if am.source_polygon[t] != side {
+            continue;
+        }
+        let w = tri.map(|v| where_(am.positions[v as usize]));
+        assert!(
+            !(w.contains(&1) && w.contains(&-1)),
+            "triangle {:?} straddles B's cut",
+            tri.map(|v| am.positions[v as usize])
+        );
+        if w.contains(&1) {
+            outside += 1;
+            // Lit by the floor and the room around: every corner of it, on the cut too.
+            for &v in tri {
+                assert!(
+                    am.colors[v as usize][0] > 0.0,
+                    "dark corner {:?} outside B",
+                    am.positions[v as usize]
+                );
+            }
+        } else {
+            inside += 1;
+            for &v in tri {
+                assert_eq!(am.colors[v as usize], [0.0; 3], "light inside B");
+            }
+        }
+    }
+    assert!(
+        outside > 0 && inside > 0,
+        "{outside} outside, {inside} inside"
+    );
+}

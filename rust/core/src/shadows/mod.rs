@@ -22,7 +22,7 @@ use crate::scene::solids::Occluder;
 use crate::scene::{Face, LightKind, Scene, Tolerances};
 use crate::shadows::critical_lines::critical_segments;
 use crate::shadows::culling::{screen_faces, screened};
-use crate::shadows::plane_cuts::{inside_solid, plane_cut};
+use crate::shadows::plane_cuts::{solid_lines, unlit_solid_lines};
 use crate::shadows::volume::{
     clip_to_volume, shadow_volumes, solid_volumes, ShadowVolumes, SolidShadow, Volume,
 };
@@ -303,6 +303,16 @@ pub fn shadow_polygons(
         stats.t_isr += t1.elapsed().as_secs_f64();
     }
     let t2 = std::time::Instant::now();
+    if scene.settings.indirect {
+        unlit_solid_lines(
+            scene,
+            &tree,
+            &outlines,
+            tol,
+            &buried.faces,
+            &mut per_receiver,
+        );
+    }
     per_receiver.par_iter_mut().for_each(|r| {
         if progress.is_cancelled() {
             return;
@@ -359,7 +369,6 @@ fn receiver_polygons(
     let mut plane_cuts = Vec::new();
     let mut inside = Vec::new();
     let mut events = Vec::new();
-    let touch = tol.touch;
     if let LightKind::Area { plane, .. } = kind {
         // Points of the receiver behind the light's plane get nothing from it.
         if let Some(poly) = clip_to_volume(
@@ -383,28 +392,16 @@ fn receiver_polygons(
         }
     }
     for &oi in hits {
-        let (verts, edges) = &outlines[oi as usize];
-        // An occluder wholly on or behind the receiver's plane cannot come between it and
-        // light arriving at its front.
-        if verts.iter().all(|v| r.plane.dist(*v) <= eps) {
-            continue;
-        }
-        for [a, b] in edges {
-            if r.plane.dist(*a).abs() <= touch && r.plane.dist(*b).abs() <= touch {
-                contacts.push([r.frame.to_2d(*a), r.frame.to_2d(*b)]);
-            }
-        }
-        let occ = &scene.occluders[oi as usize];
-        for &f in occ.faces() {
-            if let Some(c) = plane_cut(&scene.faces[f as usize].verts, r, touch) {
-                plane_cuts.push(c);
-            }
-        }
-        if let Occluder::Solid { solid, .. } = occ {
-            if let Some(p) = inside_solid(solid, r, tol) {
-                inside.push(p);
-            }
-        }
+        solid_lines(
+            r,
+            oi,
+            scene,
+            outlines,
+            tol,
+            &mut contacts,
+            &mut plane_cuts,
+            &mut inside,
+        );
     }
     for &oi in hits {
         if outlines[oi as usize]

@@ -5,9 +5,12 @@
 //! The part of a receiver inside a closed solid gets no light at all.
 
 use glam::{DVec2, DVec3};
+use rayon::prelude::*;
 
-use crate::scene::solids::Solid;
-use crate::scene::{Face, Tolerances};
+use crate::geom::bvh::{Aabb, BoxTree};
+use crate::scene::solids::{Occluder, Solid};
+use crate::scene::{Face, Scene, Tolerances};
+use crate::shadows::polygons::{Exposure, ReceiverShadows};
 use crate::shadows::volume::{clip_to_volume, Volume};
 
 /// The segment where convex occluder face `verts` crosses receiver `r`'s plane, clipped to
@@ -66,6 +69,96 @@ pub fn inside_solid(solid: &Solid, r: &Face, tol: &Tolerances) -> Option<Vec<DVe
     }
     let planes = solid.planes.iter().map(|p| p.flipped()).collect();
     clip_to_volume(r, &Volume { planes, cap: 0 }, eps)
+}
+
+/// Where occluder `oi` meets receiver `r`, whatever the light: the edges it stands on
+/// (`contacts`), the lines where its faces cross `r`'s plane (`plane_cuts`) and, for a
+/// solid, the part of `r` inside it (`inside`). An occluder wholly on or behind `r`'s plane
+/// meets nothing of its front.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn solid_lines(
+    r: &Face,
+    oi: u32,
+    scene: &Scene,
+    outlines: &[(Vec<DVec3>, Vec<[DVec3; 2]>)],
+    tol: &Tolerances,
+    contacts: &mut Vec<[DVec2; 2]>,
+    plane_cuts: &mut Vec<[DVec2; 2]>,
+    inside: &mut Vec<Vec<DVec2>>,
+) {
+    let (verts, edges) = &outlines[oi as usize];
+    let touch = tol.touch;
+    if verts.iter().all(|v| r.plane.dist(*v) <= tol.eps) {
+        return;
+    }
+    for [a, b] in edges {
+        if r.plane.dist(*a).abs() <= touch && r.plane.dist(*b).abs() <= touch {
+            contacts.push([r.frame.to_2d(*a), r.frame.to_2d(*b)]);
+        }
+    }
+    let occ = &scene.occluders[oi as usize];
+    for &f in occ.faces() {
+        if let Some(c) = plane_cut(&scene.faces[f as usize].verts, r, touch) {
+            plane_cuts.push(c);
+        }
+    }
+    if let Occluder::Solid { solid, .. } = occ {
+        if let Some(p) = inside_solid(solid, r, tol) {
+            inside.push(p);
+        }
+    }
+}
+
+/// For faces that no light reaches: where other occluders meet them (`solid_lines`), found
+/// through `tree` (a box tree over the faces). They still receive bounced light, and none
+/// where a solid cuts into them: without those lines their few elements straddle the cut,
+/// and a corner inside a neighbour darkens the whole face (room-245: the side of a box in a
+/// heap, two triangles with three corners inside other boxes, 0.09 where Cycles gives 0.90).
+pub(crate) fn unlit_solid_lines(
+    scene: &Scene,
+    tree: &BoxTree,
+    outlines: &[(Vec<DVec3>, Vec<[DVec3; 2]>)],
+    tol: &Tolerances,
+    buried: &[bool],
+    per_receiver: &mut [ReceiverShadows],
+) {
+    let faces = &scene.faces;
+    per_receiver
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(ri, pr)| {
+            if buried[ri] || pr.exposure.iter().any(|e| *e != Exposure::Hidden) {
+                return;
+            }
+            let r = &faces[ri];
+            let mut b = Aabb::from_points(&r.verts);
+            b.min -= DVec3::splat(tol.touch);
+            b.max += DVec3::splat(tol.touch);
+            let mut near = Vec::new();
+            tree.query_volume(&super::buried::box_planes(&b), tol.eps, &mut near);
+            let own = scene.face_occluder[ri];
+            let mut occs: Vec<u32> = near
+                .iter()
+                .map(|&f| scene.face_occluder[f as usize])
+                .filter(|&o| o != own && (o as usize) < scene.occluders.len())
+                .collect();
+            occs.sort_unstable();
+            occs.dedup();
+            for oi in occs {
+                solid_lines(
+                    r,
+                    oi,
+                    scene,
+                    outlines,
+                    tol,
+                    &mut pr.contacts,
+                    &mut pr.plane_cuts,
+                    &mut pr.inside,
+                );
+            }
+            pr.contacts.dedup();
+            pr.plane_cuts.dedup();
+        });
 }
 
 #[cfg(test)]
