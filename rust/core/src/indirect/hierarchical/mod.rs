@@ -200,6 +200,9 @@ pub fn indirect(
         let amb = ambient(&h, &leaves, sol.last_delta);
         at.iter_mut().for_each(|e| *e += amb);
     }
+    // A vertex's own look replaces its links' mean by subtracting (`vertices`): where it
+    // sees none of a source, rounding can leave −1e-16 of light.
+    at.iter_mut().for_each(|e| *e = e.max(DVec3::ZERO));
     result.irradiance = at;
     Ok(result)
 }
