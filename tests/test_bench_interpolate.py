@@ -1,6 +1,7 @@
 """The bench reads a Cycles user's uniform-mesh bake at the probes by linear interpolation
 (`bench_lib.probes.interpolate`): a field linear over each polygon comes back exactly, and a
-probe no triangle holds stays NaN instead of taking a neighbour's value."""
+probe no triangle holds stays NaN instead of taking a neighbour's value; and it leaves out
+the probes nobody can see (`bench_lib.probes.buried`)."""
 import os
 import sys
 
@@ -49,3 +50,28 @@ def test_a_probe_outside_its_polygon_stays_nan():
     y = probes.interpolate(fine, cols, pm, pp, px)
     np.testing.assert_allclose(y[0], 1.0)
     assert np.isnan(y[1]).all()
+
+
+def _box(lo, hi):
+    (x0, y0, z0), (x1, y1, z1) = lo, hi
+    v = [[x0, y0, z0], [x1, y0, z0], [x1, y1, z0], [x0, y1, z0],
+         [x0, y0, z1], [x1, y0, z1], [x1, y1, z1], [x0, y1, z1]]
+    f = [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]]
+    return v, f
+
+
+def test_probe_inside_a_box_behind_a_third_box_is_buried():
+    # Box A's +x side passes through B; inside B, right in front of that side, stands the
+    # -x face of C (which B also holds in part). A probe on A's side inside B sees C's front
+    # along its normal, yet lies inside B: nobody sees it. A probe on A's side outside B is
+    # seen. A floor closes nothing, so the scene is open, as the bench's are not.
+    meshes = []
+    for name, lo, hi in [("A", (0, 0, 0), (1, 1, 1)), ("B", (0.8, 0.2, 0.2), (1.6, 0.6, 0.6)),
+                         ("C", (1.3, 0.35, 0.35), (1.4, 0.45, 0.45))]:
+        v, f = _box(lo, hi)
+        meshes.append({"name": name, "positions": v, "polygons": f})
+    scene = {"meshes": meshes, "lights": []}
+    side = 3  # A's +x face in _box's order.
+    px = np.array([[1.0, 0.4, 0.4], [1.0, 0.8, 0.8]])
+    out = probes.buried(scene, np.array([0, 0]), np.array([side, side]), px)
+    assert out.tolist() == [True, False]

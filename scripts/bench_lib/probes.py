@@ -147,7 +147,11 @@ def buried(scene: dict, probe_mesh, probe_poly, probe_pos) -> np.ndarray:
     * covered by a coplanar polygon facing the other way (the floor under a box standing on
       it, and the box's bottom);
     * inside a closed solid (a face of one box inside another it intersects): the ray from
-      just in front of the probe along its normal first meets the back of a face."""
+      just in front of the probe along its normal first meets the back of a face, or the
+      probe lies strictly inside a closed convex component of another polygon (`_solids`).
+      The ray alone misses probes whose ray meets the front of a third box within the
+      solid: in a heap of clutter nearly every direction does (room-245: 141 of 1,291
+      probes lay inside other boxes, 0 in Cycles, whatever a bake gives)."""
     polys, owner = [], {}
     for mi, m in enumerate(scene["meshes"]):
         pos = np.asarray(m["positions"], dtype=np.float64)
@@ -193,4 +197,61 @@ def buried(scene: dict, probe_mesh, probe_poly, probe_pos) -> np.ndarray:
         hit, _, ti, _ = tree.ray_cast(Vector(probe_pos[k] + eps * n), Vector(n))
         if hit is not None and N[tri_poly[ti]] @ n > 0:
             out[k] = True
+    for planes, members in _solids(scene, tol):
+        inside = np.all(probe_pos @ planes[:, :3].T - planes[:, 3] < -tol, axis=1)
+        inside &= ~np.isin(pid, members)
+        out |= inside
+    return out
+
+
+def _solids(scene: dict, tol: float):
+    """Closed convex components of the scene's meshes (polygons joined by shared vertices,
+    every edge on two polygons, every vertex on or behind every polygon's plane), each as
+    its planes `[nx, ny, nz, d]` (n·x = d on the plane, outward n) and the global indices
+    of its polygons."""
+    out, base = [], 0
+    for m in scene["meshes"]:
+        pos = np.asarray(m["positions"], dtype=np.float64)
+        # Vertices at one place are one vertex, whether the polygons share its index or not.
+        if len(pos) == 0:
+            continue
+        _, first, same = np.unique(np.round(pos / max(tol, 1e-300)), axis=0,
+                                   return_index=True, return_inverse=True)
+        same = same.ravel()
+        polys = [[int(same[i]) for i in p] for p in m["polygons"]]
+        pos = pos[first]
+        parent = list(range(len(pos)))
+
+        def find(i):
+            while parent[i] != i:
+                parent[i] = parent[parent[i]]
+                i = parent[i]
+            return i
+
+        for p in polys:
+            for i in p[1:]:
+                parent[find(i)] = find(p[0])
+        groups = {}
+        for pi, p in enumerate(polys):
+            groups.setdefault(find(p[0]), []).append(pi)
+        for members in groups.values():
+            edges = {}
+            for pi in members:
+                p = polys[pi]
+                for a, b in zip(p, p[1:] + p[:1]):
+                    e = (min(a, b), max(a, b))
+                    edges[e] = edges.get(e, 0) + 1
+            if len(members) < 4 or any(c != 2 for c in edges.values()):
+                continue
+            verts = pos[sorted({i for pi in members for i in polys[pi]})]
+            planes = []
+            for pi in members:
+                v = pos[polys[pi]]
+                n = np.cross(v[1:-1] - v[0], v[2:] - v[0]).sum(0)
+                n /= np.linalg.norm(n)
+                planes.append([*n, n @ v[0]])
+            planes = np.array(planes)
+            if np.all(verts @ planes[:, :3].T - planes[:, 3] <= tol):
+                out.append((planes, np.array(members) + base))
+        base += len(polys)
     return out

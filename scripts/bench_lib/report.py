@@ -285,7 +285,7 @@ def write(res, out):
     L.append("### Speed against error (full problem: direct + indirect + colour)\n")
     for name, sc in res["scenes"].items():
         L.append(f"**{name}** — {sc['triangles']:,} input triangles, {sc['probes']:,} probes "
-                 f"({sc['probes_buried']} more under coplanar faces left out); "
+                 f"({sc['probes_buried']} more under coplanar faces or inside solids left out); "
                  f"reference noise {pct(sc['ref_full_noise_rel_rms'])} RMS (subtracted).\n")
         rows = []
         for r in sc["full_rows"]:
