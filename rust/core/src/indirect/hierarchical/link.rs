@@ -16,10 +16,8 @@
 use glam::{DVec3, Vec3};
 
 use super::hierarchy::{Hierarchy, Node};
-use crate::geom::edge_soup::clip_front;
 use crate::geom::lambert::{edges_irradiance, polygon_irradiance};
 use crate::geom::polygon::split_in_four;
-use crate::geom::polygon_factor::edges_coupling;
 use crate::mesh::elements::Elements;
 use crate::scene::Face;
 
@@ -60,6 +58,9 @@ pub struct Ends<'a> {
     /// Receiver and source normals, for planar ends.
     pub nr: Option<DVec3>,
     pub ns: Option<DVec3>,
+    /// A leaf pair's exact factor is left to `exact::fill` (the link's `k` is NaN until
+    /// then), which takes each pair once for both directions.
+    pub defer_exact: bool,
 }
 
 impl<'a> Ends<'a> {
@@ -71,6 +72,7 @@ impl<'a> Ends<'a> {
             s,
             nr: normal(r),
             ns: normal(s),
+            defer_exact: false,
         }
     }
 
@@ -123,10 +125,15 @@ impl<'a> Ends<'a> {
             }
             (Some(nr), Some(ns)) => {
                 let near = self.r.radius() + self.s.radius() > RECEIVER_NEAR * d2.sqrt();
-                if let Some(k) = near
-                    .then(|| exact_pair(h, receiver, source, nr, ns))
-                    .flatten()
-                {
+                let leaves = self.r.is_leaf() && self.s.is_leaf() && self.r.area > 0.0;
+                let exact = |()| {
+                    if self.defer_exact && leaves {
+                        Some(f64::NAN)
+                    } else {
+                        exact_pair(h, receiver, source, nr, ns)
+                    }
+                };
+                if let Some(k) = near.then_some(()).and_then(exact) {
                     k
                 } else if near && factor == Factor::Sampled {
                     // The factor varies over a receiver close to its source (two leaves
@@ -186,28 +193,10 @@ pub fn point_coefficient(
     (k, u.as_vec3())
 }
 
-/// The exact mean factor from leaf `s` (normal `ns`) over leaf `r` (normal `nr`), by the
-/// double contour integral over their boundaries (`geom::polygon_factor`), each cut to the
-/// part in front of the other's plane; `None` when either is not a leaf. Near leaves (a
-/// wall's strip by a corner, a leg's top under a seat, a floor reaching past a box's side)
-/// are where a quadrature over the receiver errs most, and always high or low for every
-/// source alike.
+/// The exact mean factor from leaf `s` (normal `ns`) over leaf `r` (normal `nr`)
+/// (`exact::coupling` over the receiver's area); `None` when either is not a leaf.
 fn exact_pair(h: &Hierarchy, r: u32, s: u32, nr: DVec3, ns: DVec3) -> Option<f64> {
-    let (rn, sn) = (&h.nodes[r as usize], &h.nodes[s as usize]);
-    if !rn.is_leaf() || !sn.is_leaf() || !(rn.area > 0.0) {
-        return None;
-    }
-    let (re, se) = (h.leaf_edges(r as usize), h.leaf_edges(s as usize));
-    let tol = 1e-9 * (rn.radius() + sn.radius());
-    let in_front =
-        |e: &[[DVec3; 2]], c: DVec3, n: DVec3| e.iter().all(|[a, _]| (*a - c).dot(n) >= -tol);
-    if in_front(re, sn.centroid, ns) && in_front(se, rn.centroid, nr) {
-        return Some(edges_coupling(re, se) / rn.area);
-    }
-    let (mut rc, mut sc) = (Vec::new(), Vec::new());
-    clip_front(re, nr, sn.centroid, ns, tol, &mut rc);
-    clip_front(se, ns, rn.centroid, nr, tol, &mut sc);
-    Some(edges_coupling(&rc, &sc) / rn.area)
+    super::exact::coupling(h, r, s, nr, ns).map(|c| c / h.nodes[r as usize].area)
 }
 
 /// Form factor from the point `p` (normal `n`) to the triangles of the planar node `s`

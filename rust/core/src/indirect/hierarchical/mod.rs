@@ -27,6 +27,7 @@
 
 mod back;
 mod buried;
+mod exact;
 mod from_point;
 mod hierarchy;
 mod link;
@@ -140,7 +141,8 @@ pub fn indirect(
         progress,
     );
     let t_refine = std::time::Instant::now();
-    let refined = refiner.run();
+    let mut refined = refiner.run();
+    exact::fill(&h, faces, &mut refined.links);
     result.t_refine = t_refine.elapsed().as_secs_f64();
     progress.check()?;
     if refined.over_budget {

@@ -179,7 +179,8 @@ impl<'a> Refiner<'a> {
             self.settle(rn, sn);
             return;
         }
-        let ends = Ends::new(h, self.vis.faces, r, s);
+        let mut ends = Ends::new(h, self.vis.faces, r, s);
+        ends.defer_exact = true;
         // Wholly behind either plane: nothing passes.
         let behind = |n: &Node, plane_node: &Node, normal: Option<glam::DVec3>| {
             normal.is_some_and(|nrm| {
