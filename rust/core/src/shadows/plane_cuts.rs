@@ -109,11 +109,12 @@ pub(crate) fn solid_lines(
     }
 }
 
-/// For faces that no light reaches: where other occluders meet them (`solid_lines`), found
-/// through `tree` (a box tree over the faces). They still receive bounced light, and none
-/// where a solid cuts into them: without those lines their few elements straddle the cut,
-/// and a corner inside a neighbour darkens the whole face (room-245: the side of a box in a
-/// heap, two triangles with three corners inside other boxes, 0.09 where Cycles gives 0.90).
+/// For faces of solids that no light reaches: where other occluders meet them
+/// (`solid_lines`), found through `tree` (a box tree over the faces). They still receive
+/// bounced light, and none where a solid cuts into them: without those lines their few
+/// elements straddle the cut, and a corner inside a neighbour darkens the whole face
+/// (room-245: the side of a box in a heap, two triangles with three corners inside other
+/// boxes, 0.09 where Cycles gives 0.90).
 pub(crate) fn unlit_solid_lines(
     scene: &Scene,
     tree: &BoxTree,
@@ -127,7 +128,16 @@ pub(crate) fn unlit_solid_lines(
         .par_iter_mut()
         .enumerate()
         .for_each(|(ri, pr)| {
-            if buried[ri] || pr.exposure.iter().any(|e| *e != Exposure::Hidden) {
+            // A lone face's back (`indirect::hierarchical::back`) shares its triangles and
+            // takes light that its front does not: what stands on the front does not touch
+            // the back, and lines cut for it only re-cut the back's leaves (the floor under a
+            // plane with a box on it moved by 3.5e-3 of its brightest, tests/two_sided.rs).
+            let own = scene.face_occluder[ri];
+            let solid = matches!(
+                scene.occluders.get(own as usize),
+                Some(Occluder::Solid { .. })
+            );
+            if !solid || buried[ri] || pr.exposure.iter().any(|e| *e != Exposure::Hidden) {
                 return;
             }
             let r = &faces[ri];
@@ -136,7 +146,6 @@ pub(crate) fn unlit_solid_lines(
             b.max += DVec3::splat(tol.touch);
             let mut near = Vec::new();
             tree.query_volume(&super::buried::box_planes(&b), tol.eps, &mut near);
-            let own = scene.face_occluder[ri];
             let mut occs: Vec<u32> = near
                 .iter()
                 .map(|&f| scene.face_occluder[f as usize])
