@@ -126,14 +126,14 @@ impl<'a> Ends<'a> {
             (Some(nr), Some(ns)) => {
                 let near = self.r.radius() + self.s.radius() > RECEIVER_NEAR * d2.sqrt();
                 let leaves = self.r.is_leaf() && self.s.is_leaf() && self.r.area > 0.0;
-                let exact = |()| {
-                    if self.defer_exact && leaves {
-                        Some(f64::NAN)
-                    } else {
-                        exact_pair(h, receiver, source, nr, ns)
-                    }
+                let exact = if !near {
+                    None
+                } else if self.defer_exact && leaves {
+                    Some(f64::NAN)
+                } else {
+                    exact_pair(h, receiver, source, nr, ns)
                 };
-                if let Some(k) = near.then_some(()).and_then(exact) {
+                if let Some(k) = exact {
                     k
                 } else if near && factor == Factor::Sampled {
                     // The factor varies over a receiver close to its source (two leaves
