@@ -150,8 +150,8 @@ def buried(scene: dict, probe_mesh, probe_poly, probe_pos) -> np.ndarray:
       just in front of the probe along its normal first meets the back of a face, or the
       probe lies strictly inside a closed convex component of another polygon (`_solids`).
       The ray alone misses probes whose ray meets the front of a third box within the
-      solid: in a heap of clutter nearly every direction does (room-245: 141 of 1,291
-      probes lay inside other boxes, 0 in Cycles, whatever a bake gives)."""
+      solid: in a heap of clutter nearly every direction does (room-245: 141 of the 1,150
+      probes kept before lay inside other boxes, 0 in Cycles, whatever a bake gives)."""
     polys, owner = [], {}
     for mi, m in enumerate(scene["meshes"]):
         pos = np.asarray(m["positions"], dtype=np.float64)
@@ -212,9 +212,10 @@ def _solids(scene: dict, tol: float):
     out, base = [], 0
     for m in scene["meshes"]:
         pos = np.asarray(m["positions"], dtype=np.float64)
-        # Vertices at one place are one vertex, whether the polygons share its index or not.
         if len(pos) == 0:
+            base += len(m["polygons"])
             continue
+        # Vertices at one place are one vertex, whether the polygons share its index or not.
         _, first, same = np.unique(np.round(pos / max(tol, 1e-300)), axis=0,
                                    return_index=True, return_inverse=True)
         same = same.ravel()

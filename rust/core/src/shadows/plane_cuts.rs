@@ -153,6 +153,7 @@ pub(crate) fn unlit_solid_lines(
                 .collect();
             occs.sort_unstable();
             occs.dedup();
+            let (mut contacts, mut plane_cuts) = (Vec::new(), Vec::new());
             for oi in occs {
                 solid_lines(
                     r,
@@ -160,13 +161,22 @@ pub(crate) fn unlit_solid_lines(
                     scene,
                     outlines,
                     tol,
-                    &mut pr.contacts,
-                    &mut pr.plane_cuts,
+                    &mut contacts,
+                    &mut plane_cuts,
                     &mut pr.inside,
                 );
             }
-            pr.contacts.dedup();
-            pr.plane_cuts.dedup();
+            // As the lights' pass keeps them: each line once.
+            for (all, new) in [
+                (&mut pr.contacts, contacts),
+                (&mut pr.plane_cuts, plane_cuts),
+            ] {
+                for c in new {
+                    if !all.contains(&c) {
+                        all.push(c);
+                    }
+                }
+            }
         });
 }
 
