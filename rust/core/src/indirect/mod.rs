@@ -288,4 +288,4 @@ where
 }
 
 #[cfg(test)]
-mod test;
+pub(crate) mod test;

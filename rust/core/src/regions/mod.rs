@@ -166,6 +166,8 @@ pub fn build_regions(
         !keep_contacts,
     );
     trim_lines(&cover, &mut sh.plane_cuts, &mut sh.contacts, &mut sh.events);
+    // Gaps belong to every light, as plane cuts do.
+    trim_lines(&cover, &mut sh.gaps, &mut Vec::new(), &mut Vec::new());
     if uniform {
         return Ok((
             uniform_regions(r, sh, tol),
@@ -219,7 +221,9 @@ pub fn build_regions(
     // Contacts too when indirect light follows: where a solid meets the receiver in umbra on
     // both sides, bounced light still reaches the side outside it and never the inside.
     let contacts: &[[DVec2; 2]] = if keep_contacts { &sh.contacts } else { &[] };
-    for (k, [a, b]) in sh.plane_cuts.iter().chain(contacts).enumerate() {
+    // Gaps last: like contacts they belong to no light, and they are not D0 lines.
+    let gaps: &[[DVec2; 2]] = if keep_contacts { &sh.gaps } else { &[] };
+    for (k, [a, b]) in sh.plane_cuts.iter().chain(contacts).chain(gaps).enumerate() {
         segs.push(Segment {
             a: *a,
             b: *b,

@@ -6,6 +6,7 @@
 pub mod buried;
 pub mod critical_lines;
 pub mod culling;
+pub mod gaps;
 pub mod plane_cuts;
 pub mod polygons;
 pub mod round;
@@ -161,6 +162,7 @@ pub fn shadow_polygons(
             plane_cuts: Vec::new(),
             inside: Vec::new(),
             events: Vec::new(),
+            gaps: Vec::new(),
         })
         .collect();
 
@@ -312,6 +314,7 @@ pub fn shadow_polygons(
             &buried.faces,
             &mut per_receiver,
         );
+        crate::shadows::gaps::gap_lines(scene, &tree, tol, &buried.faces, &mut per_receiver);
     }
     per_receiver.par_iter_mut().for_each(|r| {
         if progress.is_cancelled() {

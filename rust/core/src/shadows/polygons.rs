@@ -46,4 +46,7 @@ pub struct ReceiverShadows {
     pub inside: Vec<Vec<DVec2>>,
     /// VE/EV critical lines inside penumbrae (light index, segment), see `events`.
     pub events: Vec<(u32, [DVec2; 2])>,
+    /// Outlines of the parts across a narrow gap from another face (`gaps`), in its frame:
+    /// region boundaries for bounced light, not discontinuities.
+    pub gaps: Vec<[DVec2; 2]>,
 }
