@@ -74,10 +74,7 @@ pub(super) fn components(cdt: &Cdt, shift: DVec2, rr: &ReceiverRegions) -> Compo
         .zip(&outside)
         .map(|(&c, &out)| {
             if out {
-                Region {
-                    relations: Vec::new(),
-                    blockers: Vec::new(),
-                }
+                Region::default()
             } else {
                 rr.classify(c)
             }

@@ -189,10 +189,7 @@ pub fn mesh_receiver(
     );
     if settings.uniform {
         let mut m = extract(&cdt, shift, rr, sizing.frame(), true, tol);
-        m.regions = vec![rr.faces.first().cloned().unwrap_or(Region {
-            relations: Vec::new(),
-            blockers: Vec::new(),
-        })];
+        m.regions = vec![rr.faces.first().cloned().unwrap_or_default()];
         return Ok(m);
     }
     progress.check()?;

@@ -28,6 +28,8 @@ use arrangement::{Arrangement, Segment, BOUNDARY_TAG};
 pub struct Region {
     pub relations: Vec<Relation>,
     pub blockers: Vec<Vec<u32>>,
+    /// Across a narrow gap from another face (`shadows::gaps`).
+    pub gap: bool,
 }
 
 /// The receiver split into faces, with the edges that the mesh must conform to.
@@ -66,10 +68,16 @@ struct Classifier {
     /// Parts of the receiver inside closed solids.
     inside: Vec<Vec<DVec2>>,
     exposure: Vec<Exposure>,
+    gap_parts: Vec<Vec<DVec2>>,
 }
 
 impl Classifier {
-    fn new(polys: Vec<ShadowPolygon>, inside: Vec<Vec<DVec2>>, exposure: Vec<Exposure>) -> Self {
+    fn new(
+        polys: Vec<ShadowPolygon>,
+        inside: Vec<Vec<DVec2>>,
+        exposure: Vec<Exposure>,
+        gap_parts: Vec<Vec<DVec2>>,
+    ) -> Self {
         let boxes: Vec<(DVec2, DVec2)> = polys.iter().map(|p| bounds(&p.poly)).collect();
         let grid = BoxGrid::new(&boxes);
         Classifier {
@@ -78,6 +86,7 @@ impl Classifier {
             grid,
             inside,
             exposure,
+            gap_parts,
         }
     }
 
@@ -91,6 +100,7 @@ impl Classifier {
             return Region {
                 relations: vec![Relation::Umbra; n],
                 blockers,
+                gap: false,
             };
         }
         for (l, e) in exposure.iter().enumerate() {
@@ -133,6 +143,7 @@ impl Classifier {
         Region {
             relations,
             blockers,
+            gap: self.gap_parts.iter().any(|p| inside_convex(p, q)),
         }
     }
 }
@@ -236,7 +247,7 @@ pub fn build_regions(
     let t_lop = t1.elapsed().as_secs_f64();
 
     let t2 = std::time::Instant::now();
-    let classifier = Classifier::new(sh.polys, sh.inside, sh.exposure);
+    let classifier = Classifier::new(sh.polys, sh.inside, sh.exposure, sh.gap_parts);
     // Each face on its own: a dense receiver has hundreds of thousands.
     let faces: Vec<Region> = arr
         .faces
@@ -340,6 +351,7 @@ fn uniform_regions(r: &Face, sh: ReceiverShadows, tol: &Tolerances) -> ReceiverR
     let mut rf = Region {
         relations: vec![Relation::Lit; n],
         blockers: vec![Vec::new(); n],
+        gap: false,
     };
     for (l, e) in sh.exposure.iter().enumerate() {
         if *e == Exposure::Hidden {
@@ -370,7 +382,7 @@ fn uniform_regions(r: &Face, sh: ReceiverShadows, tol: &Tolerances) -> ReceiverR
         n_discontinuity: 0,
         n_regions: 1,
         d0_lines: sh.contacts.into_iter().chain(sh.plane_cuts).collect(),
-        classifier: Classifier::new(sh.polys, sh.inside, sh.exposure),
+        classifier: Classifier::new(sh.polys, sh.inside, sh.exposure, Vec::new()),
     }
 }
 

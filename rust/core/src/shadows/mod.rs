@@ -163,6 +163,7 @@ pub fn shadow_polygons(
             inside: Vec::new(),
             events: Vec::new(),
             gaps: Vec::new(),
+            gap_parts: Vec::new(),
         })
         .collect();
 

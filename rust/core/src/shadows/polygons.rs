@@ -49,4 +49,7 @@ pub struct ReceiverShadows {
     /// Outlines of the parts across a narrow gap from another face (`gaps`), in its frame:
     /// region boundaries for bounced light, not discontinuities.
     pub gaps: Vec<[DVec2; 2]>,
+    /// The parts those outlines bound (convex, counter-clockwise): their elements are told
+    /// apart (`Region::gap`), and refinement gives them links of their own.
+    pub gap_parts: Vec<Vec<DVec2>>,
 }

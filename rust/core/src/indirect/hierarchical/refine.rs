@@ -87,6 +87,8 @@ pub struct Refiner<'a> {
     settled: AtomicU64,
     total: f64,
     stop: AtomicBool,
+    /// Per node: it holds leaves across a narrow gap (`Region::gap`) and leaves that are not.
+    mixed: Vec<bool>,
 }
 
 pub struct Refined {
@@ -109,6 +111,7 @@ impl<'a> Refiner<'a> {
         progress: &'a Progress,
     ) -> Self {
         let total = vis.h.nodes.first().map_or(0.0, |n| n.area * n.area);
+        let mixed = mixed_nodes(&vis);
         Refiner {
             vis,
             b_max,
@@ -122,6 +125,7 @@ impl<'a> Refiner<'a> {
             settled: AtomicU64::new(0f64.to_bits()),
             total,
             stop: AtomicBool::new(false),
+            mixed,
         }
     }
 
@@ -323,6 +327,22 @@ impl<'a> Refiner<'a> {
                 self.split(&[(a, s), (b, s)], given, out)
             };
         }
+        // A receiver that holds part of a narrow gap and more, partly hidden from the
+        // source, sees it from its part in the gap only through the gap's mouth: its mean
+        // lit the gap from outside, and the facing parts passed that back and forth
+        // (room-245, two boxes' sides 3 mm apart: 0.72 deep in the gap, 0.47 split so;
+        // error from Cycles 7.15 → 6.96 %, room-78 3.83 → 3.80 %, 3 % more links). Only
+        // the receiver is split, down to the nodes that are wholly in the gap or out of it.
+        if v > 0.0
+            && v < 1.0
+            && self.mixed[r as usize]
+            && power > self.eps / FAINT_SPLIT_POWER
+            && !self.over_budget()
+        {
+            let given = Given::new(blockers.as_deref(), look.blocker.or(given.hint), crowded);
+            let [a, b] = rn.kids;
+            return self.split(&[(a, s), (b, s)], given, out);
+        }
         if v > 0.0 && faint_near && faint_split && !self.over_budget() {
             let mut given = Given::new(None, look.blocker.or(given.hint), crowded);
             given.seen = Some(v as f32);
@@ -447,4 +467,29 @@ impl<'b> Given<'b> {
 pub struct Out {
     links: Vec<Link>,
     dropped: u64,
+}
+
+/// Nodes that hold both leaves across a narrow gap and leaves that are not (a leaf lies in
+/// one region, so it is one or the other).
+fn mixed_nodes(vis: &Visibility) -> Vec<bool> {
+    let (h, el) = (vis.h, vis.el);
+    let mut kinds = vec![0u8; h.nodes.len()];
+    for i in (0..h.nodes.len()).rev() {
+        let n = &h.nodes[i];
+        kinds[i] = if n.is_leaf() {
+            let t = h.order[n.lo as usize] as usize;
+            let gap = el
+                .regions
+                .get(el.tri_region[t] as usize)
+                .is_some_and(|r| r.gap);
+            if gap {
+                1
+            } else {
+                2
+            }
+        } else {
+            kinds[n.kids[0] as usize] | kinds[n.kids[1] as usize]
+        };
+    }
+    kinds.into_iter().map(|k| k == 3).collect()
 }
