@@ -8,7 +8,9 @@
 //!   of a point-to-disc factor), is over `eps`, or
 //! - a face lies in the shaft between them and the power is over `eps / PARTIAL`, or
 //! - rays find it partly hidden and the power is over `eps / SHADOW` (then the receiver
-//!   is split first: a shadow varies over it).
+//!   is split first: a shadow varies over it), or
+//! - rays find it partly hidden and the receiver holds leaves across a narrow gap
+//!   (`Region::gap`) and leaves out of it (then the receiver is split).
 //!
 //! Otherwise the link is kept with its visibility, but for a faint near pair of faces: that
 //! one is split on down to leaves, its parts linked with its visibility and no rays of their
