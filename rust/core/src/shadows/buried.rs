@@ -38,6 +38,17 @@ fn within(s: &Solid, pts: &[DVec3], eps: f64) -> bool {
         .all(|h| pts.iter().all(|p| h.dist(*p) <= eps))
 }
 
+/// The faces of `tree` (a box tree over the scene's faces) whose boxes come within `margin`
+/// of the box of `verts`.
+pub(crate) fn faces_near(tree: &BoxTree, verts: &[DVec3], margin: f64, eps: f64) -> Vec<u32> {
+    let mut b = Aabb::from_points(verts);
+    b.min -= DVec3::splat(margin);
+    b.max += DVec3::splat(margin);
+    let mut near = Vec::new();
+    tree.query_volume(&box_planes(&b), eps, &mut near);
+    near
+}
+
 /// The six planes whose positive sides meet in box `b`, for a box-tree query.
 pub(crate) fn box_planes(b: &Aabb) -> [Plane; 6] {
     [

@@ -8,10 +8,10 @@
 //! face, projected onto the receiver, becomes a region boundary (not a D0 line: the light is
 //! continuous across it), so the hierarchy gives the part in the gap leaves of its own.
 
-use glam::{DVec2, DVec3};
+use glam::DVec2;
 use rayon::prelude::*;
 
-use crate::geom::bvh::{Aabb, BoxTree};
+use crate::geom::bvh::BoxTree;
 use crate::geom::polygon::{clip_polygon_2d_into, signed_area_2d, HalfPlane};
 use crate::scene::{Face, Scene, Tolerances};
 use crate::shadows::polygons::ReceiverShadows;
@@ -50,11 +50,7 @@ pub(crate) fn gap_lines(
             if !(reach > tol.touch) {
                 return;
             }
-            let mut b = Aabb::from_points(&r.verts);
-            b.min -= DVec3::splat(reach);
-            b.max += DVec3::splat(reach);
-            let mut near = Vec::new();
-            tree.query_volume(&super::buried::box_planes(&b), tol.eps, &mut near);
+            let mut near = super::buried::faces_near(tree, &r.verts, reach, tol.eps);
             near.sort_unstable();
             let mut lines = Vec::new();
             for f in near {
@@ -151,6 +147,7 @@ fn along_boundary(poly: &[DVec2], a: DVec2, b: DVec2, tol: f64) -> bool {
 mod test {
     use super::*;
     use crate::indirect::test::quad;
+    use glam::DVec3;
 
     fn square(c: DVec3, u: DVec3, w: DVec3) -> Face {
         quad(c, u, w, 0.5, DVec3::ZERO)

@@ -7,7 +7,7 @@
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
-use crate::geom::bvh::{Aabb, BoxTree};
+use crate::geom::bvh::BoxTree;
 use crate::scene::solids::{Occluder, Solid};
 use crate::scene::{Face, Scene, Tolerances};
 use crate::shadows::polygons::{Exposure, ReceiverShadows};
@@ -141,11 +141,7 @@ pub(crate) fn unlit_solid_lines(
                 return;
             }
             let r = &faces[ri];
-            let mut b = Aabb::from_points(&r.verts);
-            b.min -= DVec3::splat(tol.touch);
-            b.max += DVec3::splat(tol.touch);
-            let mut near = Vec::new();
-            tree.query_volume(&super::buried::box_planes(&b), tol.eps, &mut near);
+            let near = super::buried::faces_near(tree, &r.verts, tol.touch, tol.eps);
             let mut occs: Vec<u32> = near
                 .iter()
                 .map(|&f| scene.face_occluder[f as usize])
