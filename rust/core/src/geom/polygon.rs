@@ -151,6 +151,42 @@ pub fn signed_area_2d(poly: &[DVec2]) -> f64 {
     0.5 * s
 }
 
+/// Length of the closed polyline `poly`.
+pub fn perimeter(poly: &[DVec2]) -> f64 {
+    (0..poly.len())
+        .map(|k| (poly[(k + 1) % poly.len()] - poly[k]).length())
+        .sum()
+}
+
+/// The half-planes inside each edge of the counter-clockwise convex polygon `c`: their
+/// intersection is `c`.
+pub fn inside_edges(c: &[DVec2]) -> Vec<HalfPlane> {
+    let n = c.len();
+    (0..n)
+        .map(|k| {
+            let (a, b) = (c[k], c[(k + 1) % n]);
+            let nrm = (b - a).perp();
+            HalfPlane {
+                n: nrm,
+                c: nrm.dot(a),
+            }
+        })
+        .collect()
+}
+
+/// Whether both ends of segment a–b lie within `tol` of the line of one edge of `poly`:
+/// the segment runs along that edge.
+pub fn along_an_edge(poly: &[DVec2], a: DVec2, b: DVec2, tol: f64) -> bool {
+    (0..poly.len()).any(|i| {
+        let p = poly[i];
+        let d = poly[(i + 1) % poly.len()] - p;
+        let len = d.length();
+        len > 0.0
+            && (d.perp_dot(a - p) / len).abs() <= tol
+            && (d.perp_dot(b - p) / len).abs() <= tol
+    })
+}
+
 #[inline]
 pub fn coord(p: DVec2) -> Coord<f64> {
     Coord { x: p.x, y: p.y }

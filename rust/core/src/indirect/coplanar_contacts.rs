@@ -7,7 +7,7 @@ use std::collections::HashMap;
 
 use glam::DVec2;
 
-use crate::geom::polygon::{clip_polygon_2d, signed_area_2d, HalfPlane};
+use crate::geom::polygon::{clip_polygon_2d, inside_edges, perimeter, signed_area_2d, HalfPlane};
 use crate::scene::Face;
 
 /// A convex part of a face that nothing covers: its polygon (in the face's frame) and the
@@ -84,16 +84,7 @@ pub fn covers(faces: &[Face], tol: f64) -> Vec<Vec<Vec<DVec2>>> {
 /// inside the edges before it.
 fn subtract(parts: Vec<Open>, c: &[DVec2], tol: f64) -> Vec<Open> {
     let n = c.len();
-    let inside: Vec<HalfPlane> = (0..n)
-        .map(|k| {
-            let (a, b) = (c[k], c[(k + 1) % n]);
-            let nrm = (b - a).perp();
-            HalfPlane {
-                n: nrm,
-                c: nrm.dot(a),
-            }
-        })
-        .collect();
+    let inside = inside_edges(c);
     // Overlaps thinner than this are rounding, not cover.
     let min_area = |p: &[DVec2]| tol * perimeter(p);
     let mut out = Vec::with_capacity(parts.len());
@@ -123,12 +114,6 @@ fn subtract(parts: Vec<Open>, c: &[DVec2], tol: f64) -> Vec<Open> {
         }
     }
     out
-}
-
-fn perimeter(p: &[DVec2]) -> f64 {
-    (0..p.len())
-        .map(|k| (p[(k + 1) % p.len()] - p[k]).length())
-        .sum()
 }
 
 #[cfg(test)]

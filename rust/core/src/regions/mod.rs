@@ -11,7 +11,7 @@ use glam::DVec2;
 use rayon::prelude::*;
 
 use crate::geom::box_grid::{bounds, BoxGrid};
-use crate::geom::polygon::inside_convex;
+use crate::geom::polygon::{along_an_edge, inside_convex};
 use crate::geom::union_find::UnionFind;
 use crate::regions::relation::Relation;
 use crate::scene::{Face, Tolerances};
@@ -200,7 +200,7 @@ pub fn build_regions(
         for i in 0..p.poly.len() {
             let a = p.poly[i];
             let b = p.poly[(i + 1) % p.poly.len()];
-            if a != b && !on_boundary(&r.poly2, a, b, tol.boundary) {
+            if a != b && !along_an_edge(&r.poly2, a, b, tol.boundary) {
                 pieces.clear();
                 cover.uncovered(
                     a,
@@ -384,18 +384,4 @@ fn uniform_regions(r: &Face, sh: ReceiverShadows, tol: &Tolerances) -> ReceiverR
         d0_lines: sh.contacts.into_iter().chain(sh.plane_cuts).collect(),
         classifier: Classifier::new(sh.polys, sh.inside, sh.exposure, Vec::new()),
     }
-}
-
-/// Is segment a–b along an edge of the (convex) boundary? Such segments are the boundary
-/// itself, which the arrangement always has.
-fn on_boundary(poly: &[DVec2], a: DVec2, b: DVec2, tol: f64) -> bool {
-    (0..poly.len()).any(|i| {
-        let p = poly[i];
-        let q = poly[(i + 1) % poly.len()];
-        let d = q - p;
-        let len = d.length();
-        len > 0.0
-            && (d.perp_dot(a - p) / len).abs() <= tol
-            && (d.perp_dot(b - p) / len).abs() <= tol
-    })
 }

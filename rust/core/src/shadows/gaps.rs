@@ -12,7 +12,9 @@ use glam::DVec2;
 use rayon::prelude::*;
 
 use crate::geom::bvh::BoxTree;
-use crate::geom::polygon::{clip_polygon_2d_into, signed_area_2d, HalfPlane};
+use crate::geom::polygon::{
+    along_an_edge, clip_polygon_2d_into, inside_edges, perimeter, signed_area_2d,
+};
 use crate::scene::{Face, Scene, Tolerances};
 use crate::shadows::polygons::ReceiverShadows;
 
@@ -92,13 +94,7 @@ fn across(r: &Face, f: &Face, tol: &Tolerances, out: &mut Vec<[DVec2; 2]>) -> Op
     // f runs against r's orientation: reversed, its projection is counter-clockwise.
     let mut part: Vec<DVec2> = f.verts.iter().rev().map(|v| r.frame.to_2d(*v)).collect();
     let mut scratch = Vec::with_capacity(part.len() + r.poly2.len());
-    for (i, &a) in r.poly2.iter().enumerate() {
-        let b = r.poly2[(i + 1) % r.poly2.len()];
-        let e = b - a;
-        let h = HalfPlane {
-            n: DVec2::new(-e.y, e.x),
-            c: DVec2::new(-e.y, e.x).dot(a),
-        };
+    for h in inside_edges(&r.poly2) {
         clip_polygon_2d_into(&part, &h, 0.0, &mut scratch);
         std::mem::swap(&mut part, &mut scratch);
         if part.len() < 3 {
@@ -110,7 +106,7 @@ fn across(r: &Face, f: &Face, tol: &Tolerances, out: &mut Vec<[DVec2; 2]>) -> Op
     }
     for (i, &a) in part.iter().enumerate() {
         let b = part[(i + 1) % part.len()];
-        if (b - a).length() > tol.touch && !along_boundary(&r.poly2, a, b, far) {
+        if (b - a).length() > tol.touch && !along_an_edge(&r.poly2, a, b, far) {
             out.push([a, b]);
         }
     }
@@ -120,27 +116,12 @@ fn across(r: &Face, f: &Face, tol: &Tolerances, out: &mut Vec<[DVec2; 2]>) -> Op
 /// 2 × area / perimeter of a convex polygon: its inradius for a regular one, half the
 /// short side of a long rectangle.
 fn size(poly: &[DVec2]) -> f64 {
-    let perimeter: f64 = (0..poly.len())
-        .map(|i| (poly[(i + 1) % poly.len()] - poly[i]).length())
-        .sum();
-    if perimeter > 0.0 {
-        2.0 * signed_area_2d(poly).abs() / perimeter
+    let p = perimeter(poly);
+    if p > 0.0 {
+        2.0 * signed_area_2d(poly).abs() / p
     } else {
         0.0
     }
-}
-
-/// Both ends of a–b within `tol` of the line of one edge of `poly`.
-fn along_boundary(poly: &[DVec2], a: DVec2, b: DVec2, tol: f64) -> bool {
-    (0..poly.len()).any(|i| {
-        let p = poly[i];
-        let e = poly[(i + 1) % poly.len()] - p;
-        let len = e.length();
-        len > 0.0
-            && [a, b]
-                .iter()
-                .all(|x| (e.perp_dot(*x - p) / len).abs() <= tol)
-    })
 }
 
 #[cfg(test)]
