@@ -33,12 +33,14 @@
 //! rays were 2.1 % high over planar pairs and 15 % over cluster pairs (room-78, weighted by
 //! power), the second look within 0.1 % and 0.4 %; pairs dropped on their first rays were on
 //! average 12.5 % visible. The power a closed room absorbs, which must be what its light
-//! emits, per channel: room-78 101.0–101.8 % → 99.6–99.7 %, the Cornell box closed by a
-//! fifth wall 100.3–100.7 % → 99.8–100.0 % (the empty room 99.9 %: its interpolation).
-//! Against Cycles (`scripts/bench_lib/per_mesh.py`): room-78 3.80 → 3.82 % (3.68–3.77 % with
-//! other seeds for the second look), room-245 6.96 → 6.23 %, data1 0.52 → 0.40 %, chair 0.50
-//! → 0.49 %, cornell 0.69 → 0.86 %: every face of the open Cornell box is now 0.2–1.7 %
-//! darker than Cycles, where the excess had hidden that.
+//! emits, per channel: room-78 101.0–101.8 % → 99.4–99.5 %, the Cornell box closed by a
+//! fifth wall 100.3–100.7 % → 99.7–99.9 % (the empty room 99.9 %: its interpolation).
+//! A kept pair's second look casts at least `CONFIRM_RAYS`: with the 4 rays of a faint pair
+//! it scattered the final gather (the floor under a table: worst vertex 0.114–0.128 over
+//! five seeds, 0.117 with 16). Against Cycles (`scripts/bench_lib/per_mesh.py`): room-78
+//! 3.80 → 3.75 %, room-245 6.96 → 6.17 %, data1 0.52 → 0.51 %, chair 0.50 → 0.50 %, cornell
+//! 0.69 → 0.94 %: every face of the open Cornell box is now darker than Cycles, where the
+//! excess had hidden that.
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
@@ -368,9 +370,10 @@ impl<'a> Refiner<'a> {
             given.seen = Some(v as f32);
             return self.split_larger(r, s, given, out);
         }
-        // Kept because its rays all passed: see the module doc.
+        // Kept because its rays all passed: see the module doc (and why at least
+        // `CONFIRM_RAYS`).
         if v == 1.0 && cast > 0 && splits && !blockers.as_ref().is_some_and(|l| l.is_empty()) {
-            let (open, more) = self.second_look(r, s, blockers.as_deref(), rays);
+            let (open, more) = self.second_look(r, s, blockers.as_deref(), rays.max(CONFIRM_RAYS));
             v = open.unwrap_or(v);
             self.rays_cast.fetch_add(more as u64, Ordering::Relaxed);
         }

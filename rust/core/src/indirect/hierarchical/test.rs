@@ -413,12 +413,11 @@ fn floor_under_a_table_sees_no_ceiling_through_it() {
     // and 0.119 since most vertices of a leaf interpolate the visibilities its anchors found
     // (`vertices::ANCHORS`; a leaf's first look with 8 rays instead of 16 made it 0.124). A
     // vertex leaves up to `VISIBILITY_SCALE` × convergence (10 %) of its light to the means.
-    // Since kept links take their visibility from a second set of rays (`refine`): mean
-    // 1.0115, worst 0.128; with five other seeds for those rays, means 1.0127–1.0133 and
-    // worst 0.114–0.128: the worst vertex is the final gather's noise, which 0.12 sat in.
+    // Since kept links take their visibility from a second set of rays (`refine`), at
+    // least 16 of them: 1.0056 and 0.117.
     assert!(count > 50);
     assert!((mean - 1.0).abs() < 0.02, "{mean}");
-    assert!(worst < 0.135, "{worst}");
+    assert!(worst < 0.12, "{worst}");
 }
 
 #[test]
