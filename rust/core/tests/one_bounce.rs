@@ -3,8 +3,9 @@
 //! ∫ ρ_f·E(x)·F(x → wall) dx over the floor, with E the lamp's irradiance and F the point's
 //! form factor to the wall, both by Lambert's contour formula (`geom::lambert`, checked on
 //! its own against closed forms and Cycles): no visibility, no sampling. The wall is nearly
-//! black, so that what it sends back is far below the tolerance. Each solver's final values (vertex colours) carry the whole chain: the
-//! floor's direct light, its radiosity per leaf, the links and the final gather.
+//! black, so that what it sends back is far below the tolerance. Each solver's final values
+//! (vertex colours) carry the whole chain: the floor's direct light, its radiosity per leaf,
+//! the links and the final gather.
 //!
 //! Measured: over the whole wall the hierarchical solver takes 0.19 % less than the closed
 //! form, progressive refinement 0.01 %. At single points (through the CLI, read by the
