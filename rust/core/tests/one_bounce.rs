@@ -8,10 +8,11 @@
 //! the links and the final gather.
 //!
 //! Measured: over the whole wall the hierarchical solver takes 0.19 % less than the closed
-//! form, progressive refinement 0.01 %. At single points (through the CLI, read by the
-//! bench's interpolation) the hierarchical solver was 0.2–0.4 % under, progressive 0.3–0.7 %;
-//! with the floor lit evenly (a lamp far larger than the floor, the element size set by
-//! hand) both were within 0.1 %, so what is left comes from a floor whose light falls off.
+//! form, progressive refinement 0.01 %. At single points (the same scene through the CLI,
+//! `scripts/bench_lib/one_bounce_points.py`) the hierarchical solver was 0.2–0.4 % under,
+//! progressive 0.3–0.7 %; with the floor lit evenly (a lamp far larger than the floor, the
+//! element size set by hand) both were within 0.1 %, so what is left comes from a floor
+//! whose light falls off.
 
 mod common;
 
