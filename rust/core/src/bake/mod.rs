@@ -82,6 +82,10 @@ pub struct Stats {
     pub refine_passes: u64,
     pub refine_elements_added: u64,
     pub refine_evaluations: u64,
+    /// Splitting for indirect light (indirect::hierarchical::subdivide): passes, and
+    /// vertices it added.
+    pub indirect_passes: u64,
+    pub indirect_vertices_added: u64,
 }
 
 /// One output mesh per input mesh (same name and order).
@@ -279,7 +283,7 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
             .saturating_sub(m.refine.elements_before);
         stats.refine_evaluations += m.refine.evaluations;
     }
-    let elements = assemble(scene, &meshes);
+    let mut elements = assemble(scene, &meshes);
     // The per-receiver meshes are done with. Freeing them (a million small
     // allocations on a floor under a thousand shadows; 0.2 s in a debug build) happens on a
     // thread of its own, so that neither a cancel in a later stage nor the end of the bake
@@ -323,7 +327,24 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
     if let (Some(occluders), true) = (&occluders, scene.settings.indirect) {
         progress.stage("indirect light");
         let t = Instant::now();
-        let ind = indirect::indirect(scene, &elements, &irradiance, occluders, progress)?;
+        let mut ind = indirect::indirect(scene, &elements, &irradiance, occluders, progress)?;
+        if let Some(sub) = ind.subdivided.take() {
+            stats.indirect_passes = sub.passes;
+            stats.indirect_vertices_added = (sub.positions.len() - elements.positions.len()) as u64;
+            irradiance.extend_from_slice(&sub.direct);
+            if !elements.known_direct.is_empty() {
+                elements.known_direct.resize(sub.positions.len(), None);
+            }
+            elements.positions = sub.positions;
+            elements.eval = sub.eval;
+            elements.normals = sub.normals;
+            elements.vertex_face = sub.vertex_face;
+            elements.triangles = sub.triangles;
+            elements.tri_face = sub.tri_face;
+            elements.tri_region = sub.tri_region;
+            stats.N_e = elements.triangles.len() as u64;
+            stats.N_v = elements.positions.len() as u64;
+        }
         stats.T_rs = t.elapsed().as_secs_f64();
         stats.N_p = ind.patches;
         stats.shots = ind.shots;
@@ -492,7 +513,7 @@ fn output(scene: &Scene, tol: &Tolerances, el: &Elements, colors: &[[f64; 3]]) -
 /// The stats as a text table in the layout of the paper's Tables 2 and 4.
 pub fn stats_table(s: &Stats) -> String {
     let mut t = String::new();
-    let rows: [(&str, String); 30] = [
+    let rows: [(&str, String); 31] = [
         ("receivers before loop split  N_f1", s.N_f1.to_string()),
         ("faces after loop split       N_f2", s.N_f2.to_string()),
         ("discontinuity edges          N_d", s.N_d.to_string()),
@@ -573,6 +594,10 @@ pub fn stats_table(s: &Stats) -> String {
         (
             "refinement light evaluations",
             s.refine_evaluations.to_string(),
+        ),
+        (
+            "indirect splits: passes / vertices added",
+            format!("{} / {}", s.indirect_passes, s.indirect_vertices_added),
         ),
     ];
     for (k, v) in rows {

@@ -80,6 +80,9 @@ pub struct IndirectResult {
     pub hidden: u64,
     pub t_refine: f64,
     pub t_gather: f64,
+    /// Hierarchical solver only: the element mesh split where indirect light curves, with
+    /// `irradiance` then per vertex of that mesh.
+    pub subdivided: Option<hierarchical::subdivide::Subdivided>,
 }
 
 /// Patches whose apparent size (radius over distance) falls under these use 1 or ~4 rays

@@ -13,8 +13,10 @@
 //! (`solve`) run until a sweep adds less than `convergence` of the emitted power, and each
 //! element vertex gathers once more over the links above it, with factors from the vertex
 //! itself and, where a link's shaft is not clear, visibility from its leaf or itself
-//! (`vertices`). Every step gives the same bits
-//! for any thread count.
+//! (`vertices`). Where that light is not linear along an element edge (beside a contact,
+//! on a face direct light left coarse), the edge is split and its midpoint becomes a vertex
+//! (`subdivide`): the element mesh that comes out is the direct stage's, refined for
+//! indirect light. Every step gives the same bits for any thread count.
 //!
 //! Parts of faces lying against another face (`covered`) or buried in another solid
 //! (`buried`) neither shoot nor receive. The backs of thin faces with something behind them
@@ -23,7 +25,8 @@
 //!
 //! Settings: `convergence` sets both the link tolerance and the end of the solve;
 //! `visibility_rays` is the ray count for links carrying the most; `max_shots` caps the
-//! sweeps; `patch_size` is not used (the hierarchy replaces the grid patches).
+//! sweeps; `tolerance` (direct light's, times `SUBDIVIDE_SCALE`) decides the splits;
+//! `patch_size` is not used (the hierarchy replaces the grid patches).
 
 mod back;
 mod buried;
@@ -33,6 +36,7 @@ mod hierarchy;
 mod link;
 mod refine;
 mod solve;
+pub mod subdivide;
 mod vertices;
 mod visibility;
 
@@ -71,6 +75,9 @@ const LINK_FLOOR: u64 = 1 << 22;
 /// with mean visibilities 4.45 % at 6.7 and 9.70 % at 19. At 200 and 400 the floor under a
 /// table (`test`) is off by up to 14 % and 18 %.
 const VISIBILITY_SCALE: f64 = 100.0;
+/// Elements are split for indirect light (`subdivide`) where its linear interpolant errs by
+/// more than this times `tolerance` of the local light: above the final gather's noise.
+const SUBDIVIDE_SCALE: f64 = 3.0;
 /// Cap on sweeps whatever `max_shots` says.
 const MAX_SWEEPS: u64 = 1000;
 
@@ -186,7 +193,7 @@ pub fn indirect(
         occluders: &scene.occluders,
     };
     let t_gather = std::time::Instant::now();
-    let mut at = vertices::gathered(
+    let gather = vertices::Gather::new(
         &h,
         faces,
         el,
@@ -197,6 +204,17 @@ pub fn indirect(
         direct,
         VISIBILITY_SCALE * settings.convergence,
     );
+    let mut at = gather.vertices();
+    // New vertices get exact direct light but not the world's, which is sampled per vertex
+    // elsewhere (`direct::world`): with world light on, the mesh stays as it is.
+    if settings.world == DVec3::ZERO {
+        let tol = SUBDIVIDE_SCALE * settings.tolerance;
+        let sub = subdivide::subdivide(scene, &h, faces, el, &gather, direct, &at, tol, progress)?;
+        if let Some(sub) = sub {
+            at = sub.indirect.clone();
+            result.subdivided = Some(sub);
+        }
+    }
     result.t_gather = t_gather.elapsed().as_secs_f64();
     if settings.ambient {
         let amb = ambient(&h, &leaves, sol.last_delta);

@@ -58,83 +58,150 @@ const MAX_VERTEX_RAYS: u32 = 64;
 /// standard errors of the vertex's estimate, and is ignored under `NOISE` of them; between,
 /// it is blended in smoothly.
 const NOISE: f64 = 2.0;
+/// `Gather::smooth` gives up where links whose mean visibility lies between `PARTLY` and
+/// 1 − `PARTLY` bring over `PARTLY_SHARE` of the light.
+const PARTLY: f64 = 0.02;
+const PARTLY_SHARE: f64 = 0.25;
 const SURE: f64 = 4.0;
 
-/// Indirect irradiance at every element vertex by a final gather over the links `g`; vertices
-/// on no leaf (under a cover) get 0. `direct` is the direct irradiance per vertex, and
-/// `tolerance` the share of a vertex's light it may leave to its links' mean visibilities.
-#[allow(clippy::too_many_arguments)]
-pub fn gathered(
-    h: &Hierarchy,
-    faces: &[Face],
-    el: &Elements,
-    g: &Gathering,
-    solver: &Solver,
-    b: &Radiosity,
-    vis: &Visibility,
-    direct: &[DVec3],
-    tolerance: f64,
-) -> Vec<DVec3> {
-    let nv = el.positions.len();
-    let mut parent = vec![NONE; h.nodes.len()];
-    for (i, n) in h.nodes.iter().enumerate() {
-        if !n.is_leaf() {
-            parent[n.kids[0] as usize] = i as u32;
-            parent[n.kids[1] as usize] = i as u32;
-        }
-    }
-    let mut leaf_of = vec![NONE; nv];
-    for (pos, &t) in h.order.iter().enumerate() {
-        // Backs of thin faces (`back`) share the front's triangles but not its vertices.
-        if h.is_back(h.nodes[h.leaf_node[pos] as usize].face) {
-            continue;
-        }
-        for &v in &el.triangles[t as usize] {
-            if leaf_of[v as usize] == NONE {
-                leaf_of[v as usize] = h.leaf_node[pos];
-            }
-        }
-    }
-    // The vertices of each leaf, in index order: they share the links above the leaf, and
-    // the shafts from the leaf to those links' sources.
-    let mut by_leaf: Vec<(u32, u32)> = (0..nv as u32)
-        .filter(|&v| leaf_of[v as usize] != NONE)
-        .map(|v| (leaf_of[v as usize], v))
-        .collect();
-    by_leaf.sort_unstable();
-    let groups: Vec<&[(u32, u32)]> = by_leaf.chunk_by(|x, y| x.0 == y.0).collect();
-    let gather = Gather {
-        h,
-        faces,
-        el,
-        g,
-        solver,
-        b,
-        vis,
-        direct,
-        tolerance,
-        table: AreaTable::new(h),
-    };
-    let per_leaf: Vec<Vec<(u32, DVec3)>> = groups
-        .par_iter()
-        .map(|grp| {
-            let mut chain = Vec::new();
-            let mut a = grp[0].0;
-            while a != NONE {
-                chain.push(a);
-                a = parent[a as usize];
-            }
-            gather.leaf(grp[0].0, &chain, grp)
-        })
-        .collect();
-    let mut out = vec![DVec3::ZERO; nv];
-    for (v, e) in per_leaf.into_iter().flatten() {
-        out[v as usize] = e;
-    }
-    out
+/// A point where the final gather is wanted besides the vertices (`subdivide`): where it is
+/// evaluated and faces, and on which leaf.
+pub struct Point {
+    pub p: DVec3,
+    pub n: DVec3,
+    pub leaf: u32,
 }
 
-struct Gather<'a> {
+impl<'a> Gather<'a> {
+    /// `direct` is the direct irradiance per vertex, and `tolerance` the share of a
+    /// vertex's light it may leave to its links' mean visibilities.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        h: &'a Hierarchy,
+        faces: &'a [Face],
+        el: &'a Elements,
+        g: &'a Gathering,
+        solver: &'a Solver<'a>,
+        b: &'a Radiosity,
+        vis: &'a Visibility<'a>,
+        direct: &'a [DVec3],
+        tolerance: f64,
+    ) -> Self {
+        let mut parent = vec![NONE; h.nodes.len()];
+        for (i, n) in h.nodes.iter().enumerate() {
+            if !n.is_leaf() {
+                parent[n.kids[0] as usize] = i as u32;
+                parent[n.kids[1] as usize] = i as u32;
+            }
+        }
+        Gather {
+            h,
+            faces,
+            el,
+            g,
+            solver,
+            b,
+            vis,
+            direct,
+            tolerance,
+            table: AreaTable::new(h),
+            parent,
+        }
+    }
+
+    /// Leaf nodes and their ancestors, from the leaf up.
+    fn chain(&self, leaf: u32) -> Vec<u32> {
+        let mut chain = Vec::new();
+        let mut a = leaf;
+        while a != NONE {
+            chain.push(a);
+            a = self.parent[a as usize];
+        }
+        chain
+    }
+
+    /// The leaf node each vertex is gathered on (its first triangle's), or `NONE`.
+    pub fn leaf_of(&self) -> Vec<u32> {
+        let (h, el) = (self.h, self.el);
+        let mut leaf_of = vec![NONE; el.positions.len()];
+        for (pos, &t) in h.order.iter().enumerate() {
+            // Backs of thin faces (`back`) share the front's triangles but not its vertices.
+            if h.is_back(h.nodes[h.leaf_node[pos] as usize].face) {
+                continue;
+            }
+            for &v in &el.triangles[t as usize] {
+                if leaf_of[v as usize] == NONE {
+                    leaf_of[v as usize] = h.leaf_node[pos];
+                }
+            }
+        }
+        leaf_of
+    }
+
+    /// Indirect irradiance at every element vertex by a final gather over the links `g`;
+    /// vertices on no leaf (under a cover) get 0.
+    pub fn vertices(&self) -> Vec<DVec3> {
+        let nv = self.el.positions.len();
+        let leaf_of = self.leaf_of();
+        // The vertices of each leaf, in index order: they share the links above the leaf,
+        // and the shafts from the leaf to those links' sources.
+        let mut by_leaf: Vec<(u32, u32)> = (0..nv as u32)
+            .filter(|&v| leaf_of[v as usize] != NONE)
+            .map(|v| (leaf_of[v as usize], v))
+            .collect();
+        by_leaf.sort_unstable();
+        let groups: Vec<&[(u32, u32)]> = by_leaf.chunk_by(|x, y| x.0 == y.0).collect();
+        let per_leaf: Vec<Vec<(u32, DVec3)>> = groups
+            .par_iter()
+            .map(|grp| self.leaf(grp[0].0, &self.chain(grp[0].0), grp))
+            .collect();
+        let mut out = vec![DVec3::ZERO; nv];
+        for (v, e) in per_leaf.into_iter().flatten() {
+            out[v as usize] = e;
+        }
+        out
+    }
+
+    /// Indirect irradiance at `points` with their links' mean visibilities (no rays): smooth
+    /// over a leaf, so that differences between such values show how the light curves, not
+    /// the noise of rays. `None` where links seen in part (`PARTLY`) bring more than
+    /// `PARTLY_SHARE` of the light: there a mean says little of a point (a slot between two
+    /// boxes, lit by means over its mouth).
+    pub fn smooth(&self, points: &[Point]) -> Vec<Option<DVec3>> {
+        let mut by_leaf: Vec<(u32, u32)> = (0..points.len() as u32)
+            .map(|i| (points[i as usize].leaf, i))
+            .collect();
+        by_leaf.sort_unstable();
+        let groups: Vec<&[(u32, u32)]> = by_leaf.chunk_by(|x, y| x.0 == y.0).collect();
+        let per_leaf: Vec<Vec<(u32, Option<DVec3>)>> = groups
+            .par_iter()
+            .map(|grp| {
+                let chain = self.chain(grp[0].0);
+                let unsure = self.means(&chain);
+                grp.iter()
+                    .map(|&(_, i)| {
+                        let q = &points[i as usize];
+                        let mut partly = 0.0;
+                        let (e, _) = self.gathered_at(q.p, q.n, &chain, &unsure, |u, x| {
+                            if u.v > PARTLY && u.v < 1.0 - PARTLY {
+                                partly += x.element_sum() * u.v;
+                            }
+                            0.0
+                        });
+                        (i, (partly <= PARTLY_SHARE * e.element_sum()).then_some(e))
+                    })
+                    .collect()
+            })
+            .collect();
+        let mut out = vec![None; points.len()];
+        for (i, e) in per_leaf.into_iter().flatten() {
+            out[i as usize] = e;
+        }
+        out
+    }
+}
+
+pub struct Gather<'a> {
     h: &'a Hierarchy,
     faces: &'a [Face],
     el: &'a Elements,
@@ -145,6 +212,7 @@ struct Gather<'a> {
     direct: &'a [DVec3],
     tolerance: f64,
     table: AreaTable,
+    parent: Vec<u32>,
 }
 
 /// A link above a leaf from a planar source whose visibility is a mean (`Link::clear`
@@ -174,60 +242,11 @@ impl Gather<'_> {
     /// itself up are `chain`: first the leaf looks at the links it is least sure of, then
     /// each vertex at those the leaf found in part.
     fn leaf(&self, leaf: u32, chain: &[u32], verts: &[(u32, u32)]) -> Vec<(u32, DVec3)> {
-        let (h, faces, g) = (self.h, self.faces, self.g);
-        let ln = &h.nodes[leaf as usize];
-        let n = faces[ln.face as usize].plane.n;
-        let mut unsure: Vec<Unsure> = Vec::new();
-        for &a in chain {
-            for l in &g.links[self.links(g, a)] {
-                if !l.clear && h.nodes[l.source as usize].is_planar() {
-                    unsure.push(Unsure {
-                        source: l.source,
-                        v: l.v as f64,
-                        varies: false,
-                        blockers: None,
-                    });
-                }
-            }
-        }
-        // The leaf's look, at its centroid's values: the largest errors first, until what
-        // is left is under the tolerance of the darkest vertex's light.
-        if !unsure.is_empty() {
-            let c = ln.centroid;
-            let (e, errs) = self.gathered_at(c, n, chain, &unsure, |u, x| {
-                x.element_sum() * u.v.max(1.0 - u.v)
-            });
-            let darkest = verts
-                .iter()
-                .map(|&(_, v)| self.direct[v as usize].element_sum())
-                .fold(f64::INFINITY, f64::min);
-            let allowed = self.tolerance * (e.element_sum() + darkest);
-            for i in by_error(&errs, allowed) {
-                let u = &mut unsure[i];
-                let s = &h.nodes[u.source as usize];
-                let seed = mix(mix(NONE as u64 ^ leaf as u64) ^ u.source as u64);
-                let start = Start::Node(ln);
-                // A link whose rays all got through is screened through the BVH first: most
-                // screens agree, and the shaft's blocker list pays only over more rays.
-                let screened = (u.v == 1.0)
-                    .then(|| seen_from(self.vis, &self.table, start, s, None, SCREEN_RAYS, seed));
-                if screened.is_some_and(|x| x.fraction().is_none_or(|f| f == u.v)) {
-                    continue;
-                }
-                let list = self.vis.blockers(ln, s);
-                let (v, varies) = own_visibility(
-                    self.vis,
-                    &self.table,
-                    start,
-                    s,
-                    list.as_deref(),
-                    u.v,
-                    seed,
-                    screened,
-                );
-                (u.v, u.varies, u.blockers) = (v, varies, Some(list));
-            }
-        }
+        let darkest = verts
+            .iter()
+            .map(|&(_, v)| self.direct[v as usize].element_sum())
+            .fold(f64::INFINITY, f64::min);
+        let unsure = self.look(leaf, chain, darkest);
         if verts.len() <= ANCHORS || !unsure.iter().any(|u| u.varies) {
             return verts
                 .iter()
@@ -262,6 +281,71 @@ impl Gather<'_> {
             out[i].1 = self.between(v, leaf, chain, &unsure, &own);
         }
         out
+    }
+
+    /// The links above `leaf` (ancestors `chain`) whose visibility is a mean, after the
+    /// leaf's own look at them: the largest errors first, until what is left is under the
+    /// tolerance of the light of its darkest point (`darkest`, direct light summed).
+    /// The links above a leaf (ancestors `chain`) whose visibility is a mean, with their
+    /// links' means.
+    fn means(&self, chain: &[u32]) -> Vec<Unsure> {
+        let (h, g) = (self.h, self.g);
+        let mut unsure: Vec<Unsure> = Vec::new();
+        for &a in chain {
+            for l in &g.links[self.links(g, a)] {
+                if !l.clear && h.nodes[l.source as usize].is_planar() {
+                    unsure.push(Unsure {
+                        source: l.source,
+                        v: l.v as f64,
+                        varies: false,
+                        blockers: None,
+                    });
+                }
+            }
+        }
+        unsure
+    }
+
+    fn look(&self, leaf: u32, chain: &[u32], darkest: f64) -> Vec<Unsure> {
+        let (h, faces) = (self.h, self.faces);
+        let ln = &h.nodes[leaf as usize];
+        let n = faces[ln.face as usize].plane.n;
+        let mut unsure = self.means(chain);
+        // The leaf's look, at its centroid's values: the largest errors first, until what
+        // is left is under the tolerance of the darkest vertex's light.
+        if !unsure.is_empty() {
+            let c = ln.centroid;
+            let (e, errs) = self.gathered_at(c, n, chain, &unsure, |u, x| {
+                x.element_sum() * u.v.max(1.0 - u.v)
+            });
+            let allowed = self.tolerance * (e.element_sum() + darkest);
+            for i in by_error(&errs, allowed) {
+                let u = &mut unsure[i];
+                let s = &h.nodes[u.source as usize];
+                let seed = mix(mix(NONE as u64 ^ leaf as u64) ^ u.source as u64);
+                let start = Start::Node(ln);
+                // A link whose rays all got through is screened through the BVH first: most
+                // screens agree, and the shaft's blocker list pays only over more rays.
+                let screened = (u.v == 1.0)
+                    .then(|| seen_from(self.vis, &self.table, start, s, None, SCREEN_RAYS, seed));
+                if screened.is_some_and(|x| x.fraction().is_none_or(|f| f == u.v)) {
+                    continue;
+                }
+                let list = self.vis.blockers(ln, s);
+                let (v, varies) = own_visibility(
+                    self.vis,
+                    &self.table,
+                    start,
+                    s,
+                    list.as_deref(),
+                    u.v,
+                    seed,
+                    screened,
+                );
+                (u.v, u.varies, u.blockers) = (v, varies, Some(list));
+            }
+        }
+        unsure
     }
 
     /// Where vertex `v` of `leaf` is and faces, a hair towards the leaf's centre: a vertex on
@@ -337,8 +421,27 @@ impl Gather<'_> {
     /// `unsure` links: the vertex looks itself at those the leaf found in part. Also returns
     /// the visibility it used for each of `unsure` (the link's where it did not look).
     fn at(&self, v: u32, leaf: u32, chain: &[u32], unsure: &[Unsure]) -> (DVec3, Vec<f64>) {
+        let seed = v as u64;
+        self.at_point(
+            self.place(v, leaf),
+            seed,
+            self.direct[v as usize],
+            chain,
+            unsure,
+        )
+    }
+
+    /// As `at`, at the point `(p, n, face)` with direct light `direct`, its rays drawn from
+    /// `key`.
+    fn at_point(
+        &self,
+        (p, n, face): (DVec3, DVec3, u32),
+        key: u64,
+        direct: DVec3,
+        chain: &[u32],
+        unsure: &[Unsure],
+    ) -> (DVec3, Vec<f64>) {
         let h = self.h;
-        let (p, n, face) = self.place(v, leaf);
         let mut xs = Vec::with_capacity(unsure.len());
         let (mut e, errs) = self.gathered_at(p, n, chain, unsure, |u, x| {
             xs.push(x);
@@ -348,13 +451,13 @@ impl Gather<'_> {
                 0.0
             }
         });
-        let allowed = self.tolerance * (e + self.direct[v as usize]).element_sum();
+        let allowed = self.tolerance * (e + direct).element_sum();
         let mut used: Vec<f64> = unsure.iter().map(|u| u.v).collect();
         for i in by_error(&errs, allowed) {
             let u = &unsure[i];
             let s = &h.nodes[u.source as usize];
             let list = u.blockers.as_ref().and_then(|b| b.as_deref());
-            let seed = mix(mix(v as u64) ^ u.source as u64);
+            let seed = mix(mix(key) ^ u.source as u64);
             let start = Start::Point(p, n, face);
             let (own, _) = own_visibility(self.vis, &self.table, start, s, list, u.v, seed, None);
             e += xs[i] * (own - u.v);
