@@ -264,9 +264,9 @@ def new_bounce_scene(samples: int, seed: int):
     return scene
 
 
-def baked_colors_at(name: str, pos):
-    """Penumbra's colours of the baked object ``<name>_baked`` at the world points ``pos``
-    (each must be one of its vertices: its triangles conform to every input polygon)."""
+def baked_mesh(name: str):
+    """The baked object ``<name>_baked``: world vertex positions (V,3), Penumbra's colours
+    (V,3) and its triangles (T,3) as vertex indices."""
     import bpy
 
     from penumbra.blender.import_ import ATTRIBUTE
@@ -281,6 +281,16 @@ def baked_colors_at(name: str, pos):
     col = np.empty(n * 4, dtype=np.float32)
     me.color_attributes[ATTRIBUTE].data.foreach_get("color", col)
     col = col.reshape(-1, 4)[:, :3].astype(np.float64)
+    me.calc_loop_triangles()
+    tri = np.empty(len(me.loop_triangles) * 3, dtype=np.int64)
+    me.loop_triangles.foreach_get("vertices", tri)
+    return co, col, tri.reshape(-1, 3)
+
+
+def baked_colors_at(name: str, pos):
+    """Penumbra's colours of the baked object ``<name>_baked`` at the world points ``pos``
+    (each must be one of its vertices: its triangles conform to every input polygon)."""
+    co, col, _ = baked_mesh(name)
     d = np.linalg.norm(pos[:, None, :] - co[None, :, :], axis=2)
     nearest = d.argmin(axis=1)
     assert np.all(d[np.arange(len(pos)), nearest] < 1e-5), f"{name}: a grid vertex is not in the bake"

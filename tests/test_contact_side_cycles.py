@@ -60,22 +60,7 @@ def _build(seed, gridded):
 def _interpolated(name, pos, normal_axis=1, side=-HALF):
     """Penumbra's colours of `<name>_baked` at `pos`, interpolated over its triangles that
     lie in the plane y = `side`."""
-    ob = bpy.data.objects[name + "_baked"]
-    me = ob.data
-    me.calc_loop_triangles()
-    n = len(me.vertices)
-    co = np.empty(n * 3)
-    me.vertices.foreach_get("co", co)
-    mw = np.array(ob.matrix_world)
-    co = co.reshape(-1, 3) @ mw[:3, :3].T + mw[:3, 3]
-    from penumbra.blender.import_ import ATTRIBUTE
-
-    col = np.empty(n * 4, dtype=np.float32)
-    me.color_attributes[ATTRIBUTE].data.foreach_get("color", col)
-    col = col.reshape(-1, 4)[:, :3].astype(np.float64)
-    tri = np.empty(len(me.loop_triangles) * 3, dtype=np.int64)
-    me.loop_triangles.foreach_get("vertices", tri)
-    tri = tri.reshape(-1, 3)
+    co, col, tri = cr.baked_mesh(name)
     on = np.all(np.abs(co[tri][:, :, normal_axis] - side) < 1e-7, axis=1)
     tri = tri[on]
     uv = co[:, [0, 2]]
