@@ -398,7 +398,7 @@ pub(super) fn receiver_triangles(
                 / 3.0
         };
         let cs: Vec<DVec3> = (n.lo..n.hi).map(centre).collect();
-        let chosen = super::vertices::spread(&cs, k as usize);
+        let chosen = super::own_look::spread(&cs, k as usize);
         let mut w = vec![0.0; chosen.len()];
         for (i, c) in cs.iter().enumerate() {
             let j = (0..chosen.len())

@@ -29,11 +29,13 @@
 //! `patch_size` is not used (the hierarchy replaces the grid patches).
 
 mod back;
+mod bisect;
 mod buried;
 mod exact;
 mod from_point;
 mod hierarchy;
 mod link;
+mod own_look;
 mod refine;
 mod solve;
 pub mod subdivide;

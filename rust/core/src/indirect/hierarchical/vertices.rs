@@ -31,9 +31,10 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::from_point::{seen_from, AreaTable, Seen, Start};
-use super::hierarchy::{Hierarchy, Node, NONE};
+use super::from_point::{seen_from, AreaTable, Start};
+use super::hierarchy::{Hierarchy, NONE};
 use super::link::{planar_gather, point_coefficient};
+use super::own_look::{by_error, own_visibility, spread};
 use super::solve::{Gathering, Radiosity, Solver};
 use super::visibility::Visibility;
 use crate::geom::hash::mix;
@@ -42,7 +43,7 @@ use crate::scene::Face;
 
 /// Rays that screen a link whose own rays all agreed (v = 0 or 1): a vertex whose rays all
 /// agree too keeps the link's value.
-const SCREEN_RAYS: u32 = 8;
+pub(super) const SCREEN_RAYS: u32 = 8;
 /// Vertices of a leaf that look at its sources themselves (spread over it); the others take
 /// their visibilities interpolated from these (inverse square distance). A leaf holds about
 /// 20 vertices where direct light's refinement made many (room-245: 217k vertices on 10.7k
@@ -50,19 +51,10 @@ const SCREEN_RAYS: u32 = 8;
 /// took 7.9 s instead of 12.2 s, and the error from Cycles went 4.54 → 4.58 % on room-78
 /// (10: 4.57 %), cornell unchanged at 0.70 %.
 const ANCHORS: usize = 6;
-/// Rays from a vertex to a source that it checks in full; a vertex whose rays leave it in
-/// doubt (see `own_visibility`) casts as many again, up to `MAX_VERTEX_RAYS` in all.
-const REPLACE_RAYS: u32 = 16;
-const MAX_VERTEX_RAYS: u32 = 64;
-/// A vertex's own visibility replaces the link's where the two differ by more than `SURE`
-/// standard errors of the vertex's estimate, and is ignored under `NOISE` of them; between,
-/// it is blended in smoothly.
-const NOISE: f64 = 2.0;
 /// `Gather::smooth` gives up where links whose mean visibility lies between `PARTLY` and
 /// 1 − `PARTLY` bring over `PARTLY_SHARE` of the light.
 const PARTLY: f64 = 0.02;
 const PARTLY_SHARE: f64 = 0.25;
-const SURE: f64 = 4.0;
 
 /// A point where the final gather is wanted besides the vertices (`subdivide`): where it is
 /// evaluated and faces, and on which leaf.
@@ -198,6 +190,110 @@ impl<'a> Gather<'a> {
             out[i as usize] = e;
         }
         out
+    }
+}
+
+/// A leaf's look at the links above it, as the final gather made it (same rays): the
+/// leaf's visibilities of its unsure links, and where it saw some in part, its anchors'
+/// own (`Gather::leaf`). Points on the leaf take those interpolated (`Gather::looked`).
+pub struct LeafLook {
+    chain: Vec<u32>,
+    unsure: Vec<Unsure>,
+    anchors: Vec<(DVec3, Vec<f64>)>,
+}
+
+impl Gather<'_> {
+    /// Each gathered vertex's leaf and the vertex, sorted: the leaf's vertices in the order
+    /// the final gather took them (`vertices`).
+    pub fn by_leaf(&self) -> Vec<(u32, u32)> {
+        let leaf_of = self.leaf_of();
+        let mut by_leaf: Vec<(u32, u32)> = (0..leaf_of.len() as u32)
+            .filter(|&v| leaf_of[v as usize] != NONE)
+            .map(|v| (leaf_of[v as usize], v))
+            .collect();
+        by_leaf.sort_unstable();
+        by_leaf
+    }
+
+    /// The look of `leaf`, whose gathered vertices are `verts` (from `by_leaf`): the same
+    /// rays as the final gather cast there, so anchors' values agree with theirs.
+    pub fn look_again(&self, leaf: u32, verts: &[(u32, u32)]) -> LeafLook {
+        let chain = self.chain(leaf);
+        let darkest = verts
+            .iter()
+            .map(|&(_, v)| self.direct[v as usize].element_sum())
+            .fold(f64::INFINITY, f64::min);
+        let unsure = self.look(leaf, &chain, darkest);
+        let mut anchors = Vec::new();
+        if unsure.iter().any(|u| u.varies) && !verts.is_empty() {
+            let pos: Vec<DVec3> = verts
+                .iter()
+                .map(|&(_, v)| self.el.positions[v as usize])
+                .collect();
+            let picks: Vec<usize> = if verts.len() <= ANCHORS {
+                (0..verts.len()).collect()
+            } else {
+                spread(&pos, ANCHORS)
+            };
+            // Only the links the leaf saw in part differ between its points.
+            for i in picks {
+                let (_, own) = self.at(verts[i].1, leaf, &chain, &unsure);
+                let varied = own
+                    .iter()
+                    .zip(&unsure)
+                    .filter(|(_, u)| u.varies)
+                    .map(|(&o, _)| o)
+                    .collect();
+                anchors.push((pos[i], varied));
+            }
+        }
+        // Points on the leaf cast no rays of their own: blocker lists only cost memory.
+        let mut unsure = unsure;
+        unsure.iter_mut().for_each(|u| u.blockers = None);
+        LeafLook {
+            chain,
+            unsure,
+            anchors,
+        }
+    }
+
+    /// Whether links seen in part bring over `PARTLY_SHARE` of the light at the centre of
+    /// `leaf`: `smooth` gives up there, or nearly.
+    pub fn partly_seen(&self, leaf: u32) -> bool {
+        let node = &self.h.nodes[leaf as usize];
+        let q = Point {
+            p: node.centroid,
+            n: self.faces[node.face as usize].plane.n,
+            leaf,
+        };
+        self.smooth(std::slice::from_ref(&q))[0].is_none()
+    }
+
+    /// Indirect irradiance at `q` (on the leaf of `look`) with the leaf's visibilities, and
+    /// its anchors' interpolated by inverse square distance where they differ over it: no
+    /// new rays, and the values the final gather would give a vertex there that is not an
+    /// anchor.
+    pub fn looked(&self, look: &LeafLook, q: &Point) -> DVec3 {
+        let mut xs = Vec::with_capacity(look.unsure.len());
+        let (mut e, _) = self.gathered_at(q.p, q.n, &look.chain, &look.unsure, |_, x| {
+            xs.push(x);
+            0.0
+        });
+        if look.anchors.is_empty() {
+            return e;
+        }
+        let mut own = vec![0.0; look.anchors[0].1.len()];
+        let mut total = 0.0;
+        for (p, from) in &look.anchors {
+            let w = 1.0 / ((q.p - *p).length_squared() + 1e-30);
+            total += w;
+            own.iter_mut().zip(from).for_each(|(x, y)| *x += w * y);
+        }
+        let varied = look.unsure.iter().zip(xs).filter(|(u, _)| u.varies);
+        for ((u, x), o) in varied.zip(own) {
+            e += x * (o / total - u.v);
+        }
+        e
     }
 }
 
@@ -464,145 +560,5 @@ impl Gather<'_> {
             used[i] = own;
         }
         (e, used)
-    }
-}
-
-/// `k` of `points` spread over them (farthest-point picks from the first), by index.
-pub(super) fn spread(points: &[DVec3], k: usize) -> Vec<usize> {
-    let mut chosen = vec![0usize];
-    let mut near = vec![f64::INFINITY; points.len()];
-    while chosen.len() < k.min(points.len()) {
-        let last = points[*chosen.last().unwrap()];
-        let mut far = 0;
-        for (i, c) in points.iter().enumerate() {
-            near[i] = near[i].min((*c - last).length_squared());
-            if near[i] > near[far] {
-                far = i;
-            }
-        }
-        if near[far] <= 0.0 {
-            break;
-        }
-        chosen.push(far);
-    }
-    chosen
-}
-
-/// Indices of `errs` from the largest down, as far as it takes for what is left to be
-/// under `allowed` (a stable sort: the same order on every thread).
-fn by_error(errs: &[f64], allowed: f64) -> Vec<usize> {
-    let mut left: f64 = errs.iter().sum();
-    if left <= allowed {
-        return Vec::new();
-    }
-    let mut order: Vec<usize> = (0..errs.len()).collect();
-    order.sort_by(|&a, &b| errs[b].total_cmp(&errs[a]));
-    let mut out = Vec::new();
-    for i in order {
-        if left <= allowed || errs[i] <= 0.0 {
-            break;
-        }
-        left -= errs[i];
-        out.push(i);
-    }
-    out
-}
-
-/// The visibility of node `s` from the point `at` = (position, normal, scene face) that the
-/// final gather uses in place of its link's mean `lv`, from `rays` rays at first.
-///
-/// The vertex's few rays are noisy, and the mean over the link's receiver is right for most
-/// of its points (rays through slats see 40 % from everywhere): a vertex that took its own
-/// estimate for every link would scatter about the right mean. What the final gather must
-/// not miss is the vertex that sees much more or much less than the mean (under a table, a
-/// link from the ceiling to a floor node reaching past its edge). So the vertex's estimate
-/// `v` is tested against the mean: under the hypothesis that the vertex sees `lv`, its
-/// estimate's variance is about `lv·(1 − lv) / m` (`m` the effective count of its rays;
-/// stratification only lowers it), and `v·(1 − v) / m` when the vertex sees what it
-/// found. The larger of the two sets `z = |v − lv| / σ`. Under `NOISE` the mean is kept;
-/// from `SURE` on the vertex's own value is; in doubt between, the vertex casts as many rays
-/// again (up to `MAX_VERTEX_RAYS`), then blends the two smoothly.
-#[allow(clippy::too_many_arguments)]
-fn own_visibility(
-    vis: &Visibility,
-    table: &AreaTable,
-    start: Start,
-    s: &Node,
-    blockers: Option<&[u32]>,
-    lv: f64,
-    seed: u64,
-    screened: Option<Seen>,
-) -> (f64, bool) {
-    // Nothing between the leaf and the source: all of it is in sight.
-    if blockers.is_some_and(|l| l.is_empty()) {
-        return (1.0, false);
-    }
-    let varies = |seen: &Seen| seen.open > 0.0 && seen.open < seen.total;
-    let mut seen = Seen::default();
-    let mut cast = 0;
-    let mut k = REPLACE_RAYS;
-    // A link whose rays all agreed (lv 0 or 1) is screened first by a few rays: if they all
-    // agree too, the link's value stands.
-    if lv == 0.0 || lv == 1.0 {
-        seen = screened
-            .unwrap_or_else(|| seen_from(vis, table, start, s, blockers, SCREEN_RAYS, seed));
-        cast = SCREEN_RAYS;
-        match seen.fraction() {
-            Some(v) if v != lv => k = REPLACE_RAYS - SCREEN_RAYS,
-            _ => return (lv, false),
-        }
-    }
-    for round in 1u64.. {
-        seen.add(seen_from(
-            vis,
-            table,
-            start,
-            s,
-            blockers,
-            k,
-            mix(seed ^ round),
-        ));
-        cast += k;
-        let Some(v) = seen.fraction() else {
-            return (lv, false);
-        };
-        let d = (v - lv).abs();
-        let var = (lv * (1.0 - lv)).max(v * (1.0 - v)) / seen.effective().max(1.0);
-        let z = if d == 0.0 {
-            0.0
-        } else if var > 0.0 {
-            d / var.sqrt()
-        } else {
-            f64::INFINITY
-        };
-        if z <= NOISE || z >= SURE || cast >= MAX_VERTEX_RAYS {
-            let t = ((z - NOISE) / (SURE - NOISE)).clamp(0.0, 1.0);
-            return (lv + (v - lv) * t * t * (3.0 - 2.0 * t), varies(&seen));
-        }
-        k = cast.min(MAX_VERTEX_RAYS - cast);
-    }
-    (lv, false)
-}
-
-#[cfg(test)]
-mod test {
-    use super::*;
-
-    #[test]
-    fn anchors_spread_to_the_far_corners_first() {
-        // A 5 × 5 lattice: after the first point (a corner), the far corner, then the two
-        // others, then the centre.
-        let pts: Vec<DVec3> = (0..25)
-            .map(|i| DVec3::new((i % 5) as f64, (i / 5) as f64, 0.0))
-            .collect();
-        let a = spread(&pts, 5);
-        assert_eq!(a[..2], [0, 24]);
-        let mut mid = a[2..4].to_vec();
-        mid.sort();
-        assert_eq!(mid, [4, 20]);
-        assert_eq!(a[4], 12);
-        // Fewer points than asked, or all in one place: no index twice.
-        assert_eq!(spread(&pts[..3], 6), [0, 2, 1]);
-        assert_eq!(spread(&[DVec3::ZERO; 4], 3), [0]);
     }
 }

@@ -1,0 +1,161 @@
+//! A point's own look at a source, in place of its link's mean visibility (`vertices`):
+//! how many rays, and when what they found is trusted over the mean; and the helpers that
+//! choose which links and which points look.
+
+use glam::DVec3;
+
+use super::from_point::{seen_from, AreaTable, Seen, Start};
+use super::hierarchy::Node;
+use super::vertices::SCREEN_RAYS;
+use super::visibility::Visibility;
+use crate::geom::hash::mix;
+
+/// Rays from a vertex to a source that it checks in full; a vertex whose rays leave it in
+/// doubt (see `own_visibility`) casts as many again, up to `MAX_VERTEX_RAYS` in all.
+const REPLACE_RAYS: u32 = 16;
+const MAX_VERTEX_RAYS: u32 = 64;
+/// A vertex's own visibility replaces the link's where the two differ by more than `SURE`
+/// standard errors of the vertex's estimate, and is ignored under `NOISE` of them; between,
+/// it is blended in smoothly.
+const NOISE: f64 = 2.0;
+const SURE: f64 = 4.0;
+
+/// `k` of `points` spread over them (farthest-point picks from the first), by index.
+pub(super) fn spread(points: &[DVec3], k: usize) -> Vec<usize> {
+    let mut chosen = vec![0usize];
+    let mut near = vec![f64::INFINITY; points.len()];
+    while chosen.len() < k.min(points.len()) {
+        let last = points[*chosen.last().unwrap()];
+        let mut far = 0;
+        for (i, c) in points.iter().enumerate() {
+            near[i] = near[i].min((*c - last).length_squared());
+            if near[i] > near[far] {
+                far = i;
+            }
+        }
+        if near[far] <= 0.0 {
+            break;
+        }
+        chosen.push(far);
+    }
+    chosen
+}
+
+/// Indices of `errs` from the largest down, as far as it takes for what is left to be
+/// under `allowed` (a stable sort: the same order on every thread).
+pub(super) fn by_error(errs: &[f64], allowed: f64) -> Vec<usize> {
+    let mut left: f64 = errs.iter().sum();
+    if left <= allowed {
+        return Vec::new();
+    }
+    let mut order: Vec<usize> = (0..errs.len()).collect();
+    order.sort_by(|&a, &b| errs[b].total_cmp(&errs[a]));
+    let mut out = Vec::new();
+    for i in order {
+        if left <= allowed || errs[i] <= 0.0 {
+            break;
+        }
+        left -= errs[i];
+        out.push(i);
+    }
+    out
+}
+
+/// The visibility of node `s` from the point `at` = (position, normal, scene face) that the
+/// final gather uses in place of its link's mean `lv`, from `rays` rays at first.
+///
+/// The vertex's few rays are noisy, and the mean over the link's receiver is right for most
+/// of its points (rays through slats see 40 % from everywhere): a vertex that took its own
+/// estimate for every link would scatter about the right mean. What the final gather must
+/// not miss is the vertex that sees much more or much less than the mean (under a table, a
+/// link from the ceiling to a floor node reaching past its edge). So the vertex's estimate
+/// `v` is tested against the mean: under the hypothesis that the vertex sees `lv`, its
+/// estimate's variance is about `lv·(1 − lv) / m` (`m` the effective count of its rays;
+/// stratification only lowers it), and `v·(1 − v) / m` when the vertex sees what it
+/// found. The larger of the two sets `z = |v − lv| / σ`. Under `NOISE` the mean is kept;
+/// from `SURE` on the vertex's own value is; in doubt between, the vertex casts as many rays
+/// again (up to `MAX_VERTEX_RAYS`), then blends the two smoothly.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn own_visibility(
+    vis: &Visibility,
+    table: &AreaTable,
+    start: Start,
+    s: &Node,
+    blockers: Option<&[u32]>,
+    lv: f64,
+    seed: u64,
+    screened: Option<Seen>,
+) -> (f64, bool) {
+    // Nothing between the leaf and the source: all of it is in sight.
+    if blockers.is_some_and(|l| l.is_empty()) {
+        return (1.0, false);
+    }
+    let varies = |seen: &Seen| seen.open > 0.0 && seen.open < seen.total;
+    let mut seen = Seen::default();
+    let mut cast = 0;
+    let mut k = REPLACE_RAYS;
+    // A link whose rays all agreed (lv 0 or 1) is screened first by a few rays: if they all
+    // agree too, the link's value stands.
+    if lv == 0.0 || lv == 1.0 {
+        seen = screened
+            .unwrap_or_else(|| seen_from(vis, table, start, s, blockers, SCREEN_RAYS, seed));
+        cast = SCREEN_RAYS;
+        match seen.fraction() {
+            Some(v) if v != lv => k = REPLACE_RAYS - SCREEN_RAYS,
+            _ => return (lv, false),
+        }
+    }
+    for round in 1u64.. {
+        seen.add(seen_from(
+            vis,
+            table,
+            start,
+            s,
+            blockers,
+            k,
+            mix(seed ^ round),
+        ));
+        cast += k;
+        let Some(v) = seen.fraction() else {
+            return (lv, false);
+        };
+        let d = (v - lv).abs();
+        let var = (lv * (1.0 - lv)).max(v * (1.0 - v)) / seen.effective().max(1.0);
+        let z = if d == 0.0 {
+            0.0
+        } else if var > 0.0 {
+            d / var.sqrt()
+        } else {
+            f64::INFINITY
+        };
+        if z <= NOISE || z >= SURE || cast >= MAX_VERTEX_RAYS {
+            let t = ((z - NOISE) / (SURE - NOISE)).clamp(0.0, 1.0);
+            return (lv + (v - lv) * t * t * (3.0 - 2.0 * t), varies(&seen));
+        }
+        k = cast.min(MAX_VERTEX_RAYS - cast);
+    }
+    (lv, false)
+}
+
+#[cfg(test)]
+mod test {
+    use super::*;
+
+    #[test]
+    fn anchors_spread_to_the_far_corners_first() {
+        // A 5 × 5 lattice: after the first point (a corner), the far corner, then the two
+        // others, then the centre.
+        let pts: Vec<DVec3> = (0..25)
+            .map(|i| DVec3::new((i % 5) as f64, (i / 5) as f64, 0.0))
+            .collect();
+        let a = spread(&pts, 5);
+        assert_eq!(a[..2], [0, 24]);
+        let mut mid = a[2..4].to_vec();
+        mid.sort();
+        assert_eq!(mid, [4, 20]);
+        assert_eq!(a[4], 12);
+        // Fewer points than asked, or all in one place: no index twice.
+        assert_eq!(spread(&pts[..3], 6), [0, 2, 1]);
+        assert_eq!(spread(&[DVec3::ZERO; 4], 3), [0]);
+    }
+}
