@@ -108,6 +108,19 @@ def test_lights_are_the_selected_ones_or_all_visible(empty):
     assert a.name == "A"
 
 
+def test_a_far_light_does_not_coarsen_the_preset_elements(empty):
+    # The preset's sizes are fractions of the baked meshes' diagonal: a light 100 m up
+    # used to count in it, and the cube's elements grew to metres.
+    _cube().select_set(True)  # 2 m on a side: diagonal 2·√3
+    lamp = _area_light(z=3.0)
+    empty.scene.penumbra.quality = "MEDIUM"
+    near = export_scene(empty, empty.scene.penumbra).scene["settings"]["element_size"]
+    lamp.location = (0, 0, 100.0)
+    far = export_scene(empty, empty.scene.penumbra).scene["settings"]["element_size"]
+    assert near == pytest.approx(2 * math.sqrt(3) / 25, rel=1e-9)
+    assert far == pytest.approx(near, rel=1e-12)
+
+
 def test_exported_scene_is_valid_for_the_core(room_scene, empty):
     ex = export_scene(empty, empty.scene.penumbra)
     assert [m["name"] for m in ex.scene["meshes"]] == ROOM_MESHES

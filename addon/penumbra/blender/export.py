@@ -81,7 +81,7 @@ def export_scene(context, settings, objects=None):
         raise ExportError("No lights: add a light or select one (or give a material emission, or the world a colour)")
 
     outputs = [m for m in meshes if m.get("output", True)]
-    scene = {"meshes": meshes, "lights": light_dicts, "settings": settings_dict(settings, outputs, light_dicts)}
+    scene = {"meshes": meshes, "lights": light_dicts, "settings": settings_dict(settings, outputs)}
     if world is not None:
         scene["settings"]["world"] = world
     return Export(scene, sources, lights, warnings)

@@ -55,14 +55,12 @@ def polygon_area(p):
     return 0.5 * float(np.linalg.norm(np.cross(p - p[0], np.roll(p, -1, axis=0) - p[0]).sum(axis=0)))
 
 
-def settings_dict(settings, meshes, lights):
+def settings_dict(settings, meshes):
     """The scene JSON's settings from the add-on's (``scene.penumbra``, read by attribute):
-    element sizes from the quality preset as fractions of the diagonal of what is baked."""
-    pts = [m["positions"] for m in meshes if len(m["positions"])]
-    for d in lights:
-        for key in ("polygon", "point"):
-            if d.get(key) is not None:
-                pts.append(np.asarray(d[key], dtype=np.float64).reshape(-1, 3))
+    element sizes from the quality preset as fractions of the diagonal of what is baked,
+    the meshes (a light far off must not make every element coarse)."""
+    pts = [np.asarray(m["positions"], dtype=np.float64).reshape(-1, 3)
+           for m in meshes if len(m["positions"])]
     allp = np.concatenate(pts) if pts else np.zeros((1, 3))
     diag = float(np.linalg.norm(allp.max(axis=0) - allp.min(axis=0))) or 1.0
     if settings.use_custom_size:

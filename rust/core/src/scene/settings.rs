@@ -61,7 +61,7 @@ pub const DEFAULT_MAX_ELEMENTS: u64 = 4_000_000;
 pub const MAX_THREADS: u32 = 1024;
 
 impl Settings {
-    /// Defaults for a scene whose bounding box has diagonal `diag`.
+    /// Defaults for a scene whose meshes' bounding box (lights left out) has diagonal `diag`.
     pub fn from_json(s: &SettingsJson, diag: f64) -> Result<Self, BakeError> {
         let diag = if diag > 0.0 && diag.is_finite() {
             diag

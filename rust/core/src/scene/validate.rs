@@ -52,6 +52,9 @@ pub fn validate(s: &SceneJson) -> Result<Scene, BakeError> {
             "every polygon of every mesh is degenerate (no area)".into(),
         ));
     }
+    // Default element sizes follow what is baked: a light far off (a sun-sized area light
+    // 100 m up) must not make every element of a 1 m object coarse.
+    let mesh_diag = (hi - lo).length();
     let mut face_occluder = vec![u32::MAX; faces.len()];
     for (oi, o) in occluders.iter().enumerate() {
         for &f in o.faces() {
@@ -94,8 +97,7 @@ pub fn validate(s: &SceneJson) -> Result<Scene, BakeError> {
     );
     lights.extend(emitters);
     super::precision::check(&meshes, &faces, lo, hi)?;
-    let diag = (hi - lo).length();
-    let settings = Settings::from_json(&s.settings, diag)?;
+    let settings = Settings::from_json(&s.settings, mesh_diag)?;
 
     // Refuse up front what would not fit, before any stage allocates.
     let lightmaps = s.meshes.iter().filter(|m| m.uv.is_some()).count();
