@@ -90,6 +90,20 @@ struct Mid {
     vertex: u32,
 }
 
+/// What the passes learn and keep: each edge's midpoint, and values at edge ends.
+#[derive(Default)]
+struct Known {
+    mids: HashMap<(u32, u32), Mid>,
+    /// Smooth values of vertices on a leaf (`Gather::smooth`).
+    ends: HashMap<(u32, u32), DVec3>,
+    /// Leaves' own looks, made again where the means say little.
+    looks: HashMap<u32, LeafLook>,
+    /// Values at vertices on a leaf by its look (`Gather::looked`).
+    seen_ends: HashMap<(u32, u32), DVec3>,
+    /// Whether the means cannot judge a leaf's centre (`Gather::partly_seen`).
+    partly: HashMap<u32, bool>,
+}
+
 /// Splits the elements of `el` where the indirect light `indirect` (per vertex, from
 /// `gather`) is not linear to within `tol` of the local light (`direct` per vertex plus
 /// indirect, plus a floor); `None` when nothing needed it.
@@ -154,13 +168,9 @@ pub fn subdivide(
     let mut dir: Vec<DVec3> = direct.to_vec();
     // Triangles by origin: the element triangle each one came from.
     let mut origin: Vec<u32> = (0..el.triangles.len() as u32).collect();
-    let mut mids: HashMap<(u32, u32), Mid> = HashMap::new();
-    // Smooth values of vertices on a leaf (`Gather::smooth`).
-    let mut ends: HashMap<(u32, u32), DVec3> = HashMap::new();
+    let mut known = Known::default();
     let max_vertices = nv + MAX_ADDED_PER_VERTEX * nv;
-    // Leaves' own looks, made again where the means say little, and the gathered vertices
-    // of each leaf.
-    let mut looks: HashMap<u32, LeafLook> = HashMap::new();
+    // The gathered vertices of each leaf.
     let by_leaf = gather.by_leaf();
     let verts_of = |leaf: u32| {
         let lo = by_leaf.partition_point(|x| x.0 < leaf);
@@ -174,11 +184,14 @@ pub fn subdivide(
                     out: &Subdivided,
                     origin: &[u32],
                     adj: &HashMap<(u32, u32), Vec<u32>>,
-                    mids: &mut HashMap<(u32, u32), Mid>,
-                    ends: &mut HashMap<(u32, u32), DVec3>,
-                    looks: &mut HashMap<u32, LeafLook>,
-                    seen_ends: &mut HashMap<(u32, u32), DVec3>,
-                    partly: &mut HashMap<u32, bool>| {
+                    known: &mut Known| {
+        let Known {
+            mids,
+            ends,
+            looks,
+            seen_ends,
+            partly,
+        } = known;
         let todo: Vec<((u32, u32), u32)> = edges
             .iter()
             .filter(|(k, _)| !mids.contains_key(k))
@@ -387,8 +400,6 @@ pub fn subdivide(
         }
     };
 
-    let mut seen_ends: HashMap<(u32, u32), DVec3> = HashMap::new();
-    let mut partly: HashMap<u32, bool> = HashMap::new();
     let mut any = false;
     for _ in 0..MAX_PASSES {
         progress.check()?;
@@ -413,7 +424,7 @@ pub fn subdivide(
             for i in 0..3 {
                 let (a, b) = (tri[i], tri[(i + 1) % 3]);
                 let k = key(a, b);
-                if mids.contains_key(&k) {
+                if known.mids.contains_key(&k) {
                     continue;
                 }
                 let (ua, ub) = (a as usize, b as usize);
@@ -432,21 +443,11 @@ pub fn subdivide(
         if cand.is_empty() {
             break;
         }
-        evaluate(
-            &cand,
-            &out,
-            &origin,
-            &adj,
-            &mut mids,
-            &mut ends,
-            &mut looks,
-            &mut seen_ends,
-            &mut partly,
-        );
+        evaluate(&cand, &out, &origin, &adj, &mut known);
         let mut split: Vec<(u32, u32)> = cand
             .iter()
             .filter(|&&(k, _)| {
-                let m = &mids[&k];
+                let m = &known.mids[&k];
                 let (a, b) = (k.0 as usize, k.1 as usize);
                 let lin = 0.5 * (out.indirect[a] + out.indirect[b]);
                 let k = if m.smooth.is_none() { LOOK_SCALE } else { 1.0 };
@@ -480,17 +481,7 @@ pub fn subdivide(
             }
             more.sort_unstable();
             more.dedup_by_key(|x| x.0);
-            evaluate(
-                &more,
-                &out,
-                &origin,
-                &adj,
-                &mut mids,
-                &mut ends,
-                &mut looks,
-                &mut seen_ends,
-                &mut partly,
-            );
+            evaluate(&more, &out, &origin, &adj, &mut known);
             frontier.clear();
             for (k, _) in more {
                 marked.insert(k);
@@ -503,7 +494,7 @@ pub fn subdivide(
         }
         split.sort_unstable();
         for k in &split {
-            let m = mids.get_mut(k).expect("evaluated above");
+            let m = known.mids.get_mut(k).expect("evaluated above");
             m.vertex = out.positions.len() as u32;
             let a = k.0 as usize;
             out.positions.push(m.p);
@@ -512,13 +503,15 @@ pub fn subdivide(
             out.vertex_face.push(out.vertex_face[a]);
             out.indirect.push(m.indirect);
             if let (true, Some(g)) = (m.leaf != NONE, m.smooth) {
-                ends.insert((m.vertex, m.leaf), g);
+                known.ends.insert((m.vertex, m.leaf), g);
             }
             out.direct.push(m.direct);
             dir.push(m.direct);
         }
         let vertex_of = |a: u32, b: u32| -> Option<u32> {
-            mids.get(&key(a, b))
+            known
+                .mids
+                .get(&key(a, b))
                 .map(|m| m.vertex)
                 .filter(|&v| v != NONE && marked.contains(&key(a, b)))
         };
