@@ -134,14 +134,9 @@ impl<'a> Gather<'a> {
     /// vertices on no leaf (under a cover) get 0.
     pub fn vertices(&self) -> Vec<DVec3> {
         let nv = self.el.positions.len();
-        let leaf_of = self.leaf_of();
         // The vertices of each leaf, in index order: they share the links above the leaf,
         // and the shafts from the leaf to those links' sources.
-        let mut by_leaf: Vec<(u32, u32)> = (0..nv as u32)
-            .filter(|&v| leaf_of[v as usize] != NONE)
-            .map(|v| (leaf_of[v as usize], v))
-            .collect();
-        by_leaf.sort_unstable();
+        let by_leaf = self.by_leaf();
         let groups: Vec<&[(u32, u32)]> = by_leaf.chunk_by(|x, y| x.0 == y.0).collect();
         let per_leaf: Vec<Vec<(u32, DVec3)>> = groups
             .par_iter()
@@ -219,11 +214,7 @@ impl Gather<'_> {
     /// rays as the final gather cast there, so anchors' values agree with theirs.
     pub fn look_again(&self, leaf: u32, verts: &[(u32, u32)]) -> LeafLook {
         let chain = self.chain(leaf);
-        let darkest = verts
-            .iter()
-            .map(|&(_, v)| self.direct[v as usize].element_sum())
-            .fold(f64::INFINITY, f64::min);
-        let unsure = self.look(leaf, &chain, darkest);
+        let unsure = self.look(leaf, &chain, self.darkest(verts));
         let mut anchors = Vec::new();
         if unsure.iter().any(|u| u.varies) && !verts.is_empty() {
             let pos: Vec<DVec3> = verts
@@ -257,6 +248,14 @@ impl Gather<'_> {
         }
     }
 
+    /// The least direct light (channels summed) at the vertices `verts` of a leaf.
+    fn darkest(&self, verts: &[(u32, u32)]) -> f64 {
+        verts
+            .iter()
+            .map(|&(_, v)| self.direct[v as usize].element_sum())
+            .fold(f64::INFINITY, f64::min)
+    }
+
     /// Whether links seen in part bring over `PARTLY_SHARE` of the light at the centre of
     /// `leaf`: `smooth` gives up there, or nearly.
     pub fn partly_seen(&self, leaf: u32) -> bool {
@@ -283,15 +282,11 @@ impl Gather<'_> {
             return e;
         }
         let mut own = vec![0.0; look.anchors[0].1.len()];
-        let mut total = 0.0;
-        for (p, from) in &look.anchors {
-            let w = 1.0 / ((q.p - *p).length_squared() + 1e-30);
-            total += w;
-            own.iter_mut().zip(from).for_each(|(x, y)| *x += w * y);
-        }
+        let from = look.anchors.iter().map(|(p, f)| (*p, &f[..]));
+        inverse_square(q.p, from, &mut own);
         let varied = look.unsure.iter().zip(xs).filter(|(u, _)| u.varies);
         for ((u, x), o) in varied.zip(own) {
-            e += x * (o / total - u.v);
+            e += x * (o - u.v);
         }
         e
     }
@@ -338,11 +333,7 @@ impl Gather<'_> {
     /// itself up are `chain`: first the leaf looks at the links it is least sure of, then
     /// each vertex at those the leaf found in part.
     fn leaf(&self, leaf: u32, chain: &[u32], verts: &[(u32, u32)]) -> Vec<(u32, DVec3)> {
-        let darkest = verts
-            .iter()
-            .map(|&(_, v)| self.direct[v as usize].element_sum())
-            .fold(f64::INFINITY, f64::min);
-        let unsure = self.look(leaf, chain, darkest);
+        let unsure = self.look(leaf, chain, self.darkest(verts));
         if verts.len() <= ANCHORS || !unsure.iter().any(|u| u.varies) {
             return verts
                 .iter()
@@ -366,14 +357,8 @@ impl Gather<'_> {
             if anchors.contains(&i) {
                 continue;
             }
-            own.fill(0.0);
-            let mut total = 0.0;
-            for (&j, from) in anchors.iter().zip(&seen) {
-                let w = 1.0 / ((pos[i] - pos[j]).length_squared() + 1e-30);
-                total += w;
-                own.iter_mut().zip(from).for_each(|(x, y)| *x += w * y);
-            }
-            own.iter_mut().for_each(|x| *x /= total);
+            let from = anchors.iter().zip(&seen).map(|(&j, f)| (pos[j], &f[..]));
+            inverse_square(pos[i], from, &mut own);
             out[i].1 = self.between(v, leaf, chain, &unsure, &own);
         }
         out
@@ -561,4 +546,17 @@ impl Gather<'_> {
         }
         (e, used)
     }
+}
+
+/// The anchors' visibilities `from` (position, one per link) interpolated to `at` by
+/// inverse square distance, into `own`.
+fn inverse_square<'x>(at: DVec3, from: impl Iterator<Item = (DVec3, &'x [f64])>, own: &mut [f64]) {
+    own.fill(0.0);
+    let mut total = 0.0;
+    for (p, f) in from {
+        let w = 1.0 / ((at - p).length_squared() + 1e-30);
+        total += w;
+        own.iter_mut().zip(f).for_each(|(x, y)| *x += w * y);
+    }
+    own.iter_mut().for_each(|x| *x /= total);
 }
