@@ -206,12 +206,14 @@ pub fn indirect(
         direct,
         VISIBILITY_SCALE * settings.convergence,
     );
-    let mut at = gather.vertices();
+    let (mut at, looks) = gather.vertices();
     // New vertices get exact direct light but not the world's, which is sampled per vertex
     // elsewhere (`direct::world`): with world light on, the mesh stays as it is.
     if settings.world == DVec3::ZERO {
         let tol = SUBDIVIDE_SCALE * settings.tolerance;
-        let sub = subdivide::subdivide(scene, &h, faces, el, &gather, direct, &at, tol, progress)?;
+        let sub = subdivide::subdivide(
+            scene, &h, faces, el, &gather, &looks, direct, &at, tol, progress,
+        )?;
         if let Some(sub) = sub {
             at = sub.indirect.clone();
             result.subdivided = Some(sub);

@@ -13,7 +13,7 @@
 //! rays, at the midpoint and at both ends, so a curve is told from the noise of rays. Where
 //! links seen in part bring much of the light (between boxes, under a shelf) means say
 //! little of a point, and the leaf's own look judges instead (`Gather::looked`): the rays
-//! the final gather cast from the leaf and its anchors, made again for that leaf, and their
+//! the final gather cast from the leaf and its anchors, kept from it (`LeafLook`), and their
 //! visibilities interpolated to the point; its noise asks `LOOK_SCALE` times the
 //! tolerance. Without it such edges stayed whole, and room-78 was 3.66 % from Cycles
 //! (2.98 % with it). A new vertex takes the value of whichever judged it plus the mean of
@@ -96,8 +96,6 @@ struct Known {
     mids: HashMap<(u32, u32), Mid>,
     /// Smooth values of vertices on a leaf (`Gather::smooth`).
     ends: HashMap<(u32, u32), DVec3>,
-    /// Leaves' own looks, made again where the means say little.
-    looks: HashMap<u32, LeafLook>,
     /// Values at vertices on a leaf by its look (`Gather::looked`).
     seen_ends: HashMap<(u32, u32), DVec3>,
     /// Whether the means cannot judge a leaf's centre (`Gather::partly_seen`).
@@ -114,6 +112,7 @@ pub fn subdivide(
     faces: &[Face],
     el: &Elements,
     gather: &Gather,
+    looks: &HashMap<u32, LeafLook>,
     direct: &[DVec3],
     indirect: &[DVec3],
     tol: f64,
@@ -170,13 +169,6 @@ pub fn subdivide(
     let mut origin: Vec<u32> = (0..el.triangles.len() as u32).collect();
     let mut known = Known::default();
     let max_vertices = nv + MAX_ADDED_PER_VERTEX * nv;
-    // The gathered vertices of each leaf.
-    let by_leaf = gather.by_leaf();
-    let verts_of = |leaf: u32| {
-        let lo = by_leaf.partition_point(|x| x.0 < leaf);
-        let hi = by_leaf.partition_point(|x| x.0 <= leaf);
-        &by_leaf[lo..hi]
-    };
     let key = |a: u32, b: u32| (a.min(b), a.max(b));
 
     // Evaluates the midpoints of `edges` (with a triangle holding each) not yet known.
@@ -188,7 +180,6 @@ pub fn subdivide(
         let Known {
             mids,
             ends,
-            looks,
             seen_ends,
             partly,
         } = known;
@@ -326,19 +317,7 @@ pub fn subdivide(
             value[i] = m + 0.5 * own;
             g[i] = Some(m);
         }
-        let mut need: Vec<u32> = looked
-            .iter()
-            .map(|&(i, _)| leaf_of[i])
-            .filter(|l| !looks.contains_key(l))
-            .collect();
-        need.sort_unstable();
-        need.dedup();
-        let made: Vec<(u32, LeafLook)> = need
-            .par_iter()
-            .map(|&l| (l, gather.look_again(l, verts_of(l))))
-            .collect();
-        looks.extend(made);
-        let looks = &*looks;
+        let none = LeafLook::default();
         let at = |q: DVec3, leaf: u32, t: u32| {
             let face = el.tri_face[origin[t as usize] as usize];
             let point = Point {
@@ -346,7 +325,7 @@ pub fn subdivide(
                 n: faces[face as usize].plane.n,
                 leaf,
             };
-            gather.looked(&looks[&leaf], &point)
+            gather.looked(looks.get(&leaf).unwrap_or(&none), &point)
         };
         // The ends first, each once per leaf (an end serves the edges around it).
         let mut end_todo: Vec<(u32, u32, u32)> = Vec::new();

@@ -28,6 +28,8 @@
 //! Cluster sources keep their links' means: a point that sees less of a cluster's far side
 //! sees more of its near side, and a fraction of the whole says nothing of which.
 
+use std::collections::HashMap;
+
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -131,22 +133,27 @@ impl<'a> Gather<'a> {
     }
 
     /// Indirect irradiance at every element vertex by a final gather over the links `g`;
-    /// vertices on no leaf (under a cover) get 0.
-    pub fn vertices(&self) -> Vec<DVec3> {
+    /// vertices on no leaf (under a cover) get 0. Also each gathered leaf's look, for
+    /// points on it later (`looked`).
+    pub fn vertices(&self) -> (Vec<DVec3>, HashMap<u32, LeafLook>) {
         let nv = self.el.positions.len();
         // The vertices of each leaf, in index order: they share the links above the leaf,
         // and the shafts from the leaf to those links' sources.
         let by_leaf = self.by_leaf();
         let groups: Vec<&[(u32, u32)]> = by_leaf.chunk_by(|x, y| x.0 == y.0).collect();
-        let per_leaf: Vec<Vec<(u32, DVec3)>> = groups
+        let per_leaf: Vec<(Vec<(u32, DVec3)>, LeafLook)> = groups
             .par_iter()
             .map(|grp| self.leaf(grp[0].0, &self.chain(grp[0].0), grp))
             .collect();
         let mut out = vec![DVec3::ZERO; nv];
-        for (v, e) in per_leaf.into_iter().flatten() {
-            out[v as usize] = e;
+        let mut looks = HashMap::with_capacity(groups.len());
+        for (grp, (vals, look)) in groups.iter().zip(per_leaf) {
+            for (v, e) in vals {
+                out[v as usize] = e;
+            }
+            looks.insert(grp[0].0, look);
         }
-        out
+        (out, looks)
     }
 
     /// Indirect irradiance at `points` with their links' mean visibilities (no rays): smooth
@@ -188,19 +195,52 @@ impl<'a> Gather<'a> {
     }
 }
 
-/// A leaf's look at the links above it, as the final gather made it (same rays): the
-/// leaf's visibilities of its unsure links, and where it saw some in part, its anchors'
-/// own (`Gather::leaf`). Points on the leaf take those interpolated (`Gather::looked`).
+/// A leaf's look at the links above it, as the final gather made it (`Gather::leaf`):
+/// the visibilities the leaf found in place of its unsure links' means (index among them,
+/// visibility, whether its rays found the source in part), and where it found some in
+/// part, its anchors' own for those. Points on the leaf take those interpolated
+/// (`Gather::looked`) without casting rays; a leaf with no look keeps its links' means.
+/// Kept from the gather itself: made again, the looks cost `subdivide` a quarter of its
+/// time on room-78.
+#[derive(Default)]
 pub struct LeafLook {
-    chain: Vec<u32>,
-    unsure: Vec<Unsure>,
+    changed: Vec<(u32, f64, bool)>,
     anchors: Vec<(DVec3, Vec<f64>)>,
+}
+
+impl LeafLook {
+    /// What the leaf's look at its `unsure` links and its `anchors` (position, and the
+    /// visibility each used for every unsure link) keep of it.
+    fn keep(unsure: &[Unsure], anchors: impl Iterator<Item = (DVec3, Vec<f64>)>) -> Self {
+        let changed = unsure
+            .iter()
+            .enumerate()
+            .filter(|(_, u)| u.blockers.is_some())
+            .map(|(i, u)| (i as u32, u.v, u.varies))
+            .collect();
+        let anchors = if unsure.iter().any(|u| u.varies) {
+            anchors
+                .map(|(p, own)| {
+                    let varied = own
+                        .iter()
+                        .zip(unsure)
+                        .filter(|(_, u)| u.varies)
+                        .map(|(&o, _)| o)
+                        .collect();
+                    (p, varied)
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        LeafLook { changed, anchors }
+    }
 }
 
 impl Gather<'_> {
     /// Each gathered vertex's leaf and the vertex, sorted: the leaf's vertices in the order
     /// the final gather took them (`vertices`).
-    pub fn by_leaf(&self) -> Vec<(u32, u32)> {
+    fn by_leaf(&self) -> Vec<(u32, u32)> {
         let leaf_of = self.leaf_of();
         let mut by_leaf: Vec<(u32, u32)> = (0..leaf_of.len() as u32)
             .filter(|&v| leaf_of[v as usize] != NONE)
@@ -208,44 +248,6 @@ impl Gather<'_> {
             .collect();
         by_leaf.sort_unstable();
         by_leaf
-    }
-
-    /// The look of `leaf`, whose gathered vertices are `verts` (from `by_leaf`): the same
-    /// rays as the final gather cast there, so anchors' values agree with theirs.
-    pub fn look_again(&self, leaf: u32, verts: &[(u32, u32)]) -> LeafLook {
-        let chain = self.chain(leaf);
-        let unsure = self.look(leaf, &chain, self.darkest(verts));
-        let mut anchors = Vec::new();
-        if unsure.iter().any(|u| u.varies) && !verts.is_empty() {
-            let pos: Vec<DVec3> = verts
-                .iter()
-                .map(|&(_, v)| self.el.positions[v as usize])
-                .collect();
-            let picks: Vec<usize> = if verts.len() <= ANCHORS {
-                (0..verts.len()).collect()
-            } else {
-                spread(&pos, ANCHORS)
-            };
-            // Only the links the leaf saw in part differ between its points.
-            for i in picks {
-                let (_, own) = self.at(verts[i].1, leaf, &chain, &unsure);
-                let varied = own
-                    .iter()
-                    .zip(&unsure)
-                    .filter(|(_, u)| u.varies)
-                    .map(|(&o, _)| o)
-                    .collect();
-                anchors.push((pos[i], varied));
-            }
-        }
-        // Points on the leaf cast no rays of their own: blocker lists only cost memory.
-        let mut unsure = unsure;
-        unsure.iter_mut().for_each(|u| u.blockers = None);
-        LeafLook {
-            chain,
-            unsure,
-            anchors,
-        }
     }
 
     /// The least direct light (channels summed) at the vertices `verts` of a leaf.
@@ -273,8 +275,13 @@ impl Gather<'_> {
     /// new rays, and the values the final gather would give a vertex there that is not an
     /// anchor.
     pub fn looked(&self, look: &LeafLook, q: &Point) -> DVec3 {
-        let mut xs = Vec::with_capacity(look.unsure.len());
-        let (mut e, _) = self.gathered_at(q.p, q.n, &look.chain, &look.unsure, |_, x| {
+        let chain = self.chain(q.leaf);
+        let mut unsure = self.means(&chain);
+        for &(i, v, varies) in &look.changed {
+            (unsure[i as usize].v, unsure[i as usize].varies) = (v, varies);
+        }
+        let mut xs = Vec::with_capacity(unsure.len());
+        let (mut e, _) = self.gathered_at(q.p, q.n, &chain, &unsure, |_, x| {
             xs.push(x);
             0.0
         });
@@ -284,7 +291,7 @@ impl Gather<'_> {
         let mut own = vec![0.0; look.anchors[0].1.len()];
         let from = look.anchors.iter().map(|(p, f)| (*p, &f[..]));
         inverse_square(q.p, from, &mut own);
-        let varied = look.unsure.iter().zip(xs).filter(|(u, _)| u.varies);
+        let varied = unsure.iter().zip(xs).filter(|(u, _)| u.varies);
         for ((u, x), o) in varied.zip(own) {
             e += x * (o - u.v);
         }
@@ -332,18 +339,30 @@ impl Gather<'_> {
     /// Irradiance at the vertices `verts` (leaf, vertex) of `leaf`, whose ancestors from
     /// itself up are `chain`: first the leaf looks at the links it is least sure of, then
     /// each vertex at those the leaf found in part.
-    fn leaf(&self, leaf: u32, chain: &[u32], verts: &[(u32, u32)]) -> Vec<(u32, DVec3)> {
+    fn leaf(
+        &self,
+        leaf: u32,
+        chain: &[u32],
+        verts: &[(u32, u32)],
+    ) -> (Vec<(u32, DVec3)>, LeafLook) {
         let unsure = self.look(leaf, chain, self.darkest(verts));
-        if verts.len() <= ANCHORS || !unsure.iter().any(|u| u.varies) {
-            return verts
-                .iter()
-                .map(|&(_, v)| (v, self.at(v, leaf, chain, &unsure).0))
-                .collect();
-        }
         let pos: Vec<DVec3> = verts
             .iter()
             .map(|&(_, v)| self.el.positions[v as usize])
             .collect();
+        if verts.len() <= ANCHORS || !unsure.iter().any(|u| u.varies) {
+            let at: Vec<(DVec3, Vec<f64>)> = verts
+                .iter()
+                .map(|&(_, v)| self.at(v, leaf, chain, &unsure))
+                .collect();
+            let look = LeafLook::keep(&unsure, pos.iter().zip(&at).map(|(&p, a)| (p, a.1.clone())));
+            let out = verts
+                .iter()
+                .zip(at)
+                .map(|(&(_, v), (e, _))| (v, e))
+                .collect();
+            return (out, look);
+        }
         let anchors = spread(&pos, ANCHORS);
         let mut out: Vec<(u32, DVec3)> = verts.iter().map(|&(_, v)| (v, DVec3::ZERO)).collect();
         let mut seen: Vec<Vec<f64>> = Vec::with_capacity(anchors.len());
@@ -361,7 +380,8 @@ impl Gather<'_> {
             inverse_square(pos[i], from, &mut own);
             out[i].1 = self.between(v, leaf, chain, &unsure, &own);
         }
-        out
+        let look = LeafLook::keep(&unsure, anchors.iter().map(|&j| pos[j]).zip(seen));
+        (out, look)
     }
 
     /// The links above `leaf` (ancestors `chain`) whose visibility is a mean, after the
