@@ -85,6 +85,8 @@ struct Mid {
     indirect: DVec3,
     /// Its smooth value, on `leaf` (NONE: in none), where the means say enough.
     smooth: Option<DVec3>,
+    /// Its value by the leaf's look (`Gather::looked`), where that judged it instead.
+    looked: Option<DVec3>,
     leaf: u32,
     /// Vertex id once the edge is split.
     vertex: u32,
@@ -345,7 +347,8 @@ pub fn subdivide(
             .collect();
         seen_ends.extend(end_vals);
         let seen_ends = &*seen_ends;
-        let by_look: Vec<(usize, f64, DVec3)> = looked
+        let mut by_leaf_look = vec![None; todo.len()];
+        let by_look: Vec<(usize, f64, DVec3, DVec3)> = looked
             .par_iter()
             .map(|&(i, t)| {
                 let ((a, b), _) = todo[i];
@@ -355,12 +358,13 @@ pub fn subdivide(
                 let lb = seen_ends[&(b, leaf)];
                 let err = (m - 0.5 * (la + lb)).abs().element_sum();
                 let own = (out.indirect[a as usize] - la) + (out.indirect[b as usize] - lb);
-                (i, err, m + 0.5 * own)
+                (i, err, m + 0.5 * own, m)
             })
             .collect();
-        for (i, e, v) in by_look {
+        for (i, e, v, m) in by_look {
             err[i] = e;
             value[i] = v;
+            by_leaf_look[i] = Some(m);
         }
         for (i, (&((a, b), _), &(p, eval, e))) in todo.iter().zip(&lit).enumerate() {
             mids.insert(
@@ -372,6 +376,7 @@ pub fn subdivide(
                     err: err[i],
                     indirect: value[i],
                     smooth: g[i],
+                    looked: by_leaf_look[i],
                     leaf: leaf_of[i],
                     vertex: NONE,
                 },
@@ -481,8 +486,14 @@ pub fn subdivide(
             out.normals.push(out.normals[a]);
             out.vertex_face.push(out.vertex_face[a]);
             out.indirect.push(m.indirect);
-            if let (true, Some(g)) = (m.leaf != NONE, m.smooth) {
-                known.ends.insert((m.vertex, m.leaf), g);
+            // A new vertex is an end of the next pass's edges: its value there is known.
+            if m.leaf != NONE {
+                if let Some(g) = m.smooth {
+                    known.ends.insert((m.vertex, m.leaf), g);
+                }
+                if let Some(g) = m.looked {
+                    known.seen_ends.insert((m.vertex, m.leaf), g);
+                }
             }
             out.direct.push(m.direct);
             dir.push(m.direct);
