@@ -35,8 +35,12 @@ use crate::progress::Progress;
 use crate::scene::{Face, Scene};
 use crate::BakeError;
 
-/// Passes of splitting at most; each halves the edges it splits.
-const MAX_PASSES: usize = 6;
+/// Passes of splitting at most; each halves the edges it splits. Each pass adds about as
+/// many vertices as the one before (room-78: 2.7k, 3.3k, 3.7k, 3.9k, 4.1k, 3.5k), but the
+/// error from Cycles (`per_mesh.py`) settles after three: room-78 3.75 % with none, 3.01 %
+/// after 2, 2.99 % after 3, 2.98 % after 4 and 6; room-245 5.24 / 5.20 / 5.20 % after 2 / 3
+/// / 6; cornell, chair and data1 the same after 2 as after 6.
+const MAX_PASSES: usize = 3;
 /// An edge is gathered again at its midpoint when its ends' indirect light differs by more
 /// than this times the allowed error: a curve whose ends agree has little room to sag.
 const SCREEN: f64 = 2.0;
