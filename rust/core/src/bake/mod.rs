@@ -336,9 +336,9 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
                 elements.known_direct.resize(sub.positions.len(), None);
             }
             elements.positions = sub.positions;
-            elements.eval = sub.eval;
-            elements.normals = sub.normals;
-            elements.vertex_face = sub.vertex_face;
+            elements.eval.extend(sub.eval);
+            elements.normals.extend(sub.normals);
+            elements.vertex_face.extend(sub.vertex_face);
             elements.triangles = sub.triangles;
             elements.tri_face = sub.tri_face;
             elements.tri_region = sub.tri_region;

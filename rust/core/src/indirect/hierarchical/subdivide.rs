@@ -58,10 +58,14 @@ const MAX_ADDED_PER_VERTEX: usize = 1;
 const FLOOR: f64 = 0.05;
 
 /// What the splits add to the element mesh: vertices after the old ones (same ids for
-/// those), with their direct light, and the whole new triangle list.
+/// those), with their direct light, and the whole new triangle list. The added vertices'
+/// attributes but their positions are kept apart from the old ones' (room-8328 has 5.8M
+/// vertices: a copy of each array is 20–140 MB).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Subdivided {
+    /// Every vertex's, old and added.
     pub positions: Vec<DVec3>,
+    /// The added vertices'.
     pub eval: Vec<DVec3>,
     pub normals: Vec<DVec3>,
     pub vertex_face: Vec<u32>,
@@ -75,11 +79,10 @@ pub struct Subdivided {
     pub passes: u64,
 }
 
-/// A midpoint lit and judged, kept whether or not its edge was split.
+/// A midpoint lit and judged, kept while its edge is whole (where and how it is evaluated
+/// are its ends' means: the edge is the key).
 #[derive(Clone, Copy)]
 struct Mid {
-    p: DVec3,
-    eval: DVec3,
     direct: DVec3,
     /// How far the indirect light there lies from the edge's interpolant, with the leaf's
     /// visibilities (`Gather::smooth`), channels summed.
@@ -87,13 +90,22 @@ struct Mid {
     /// Indirect irradiance there: the smooth value, plus the ends' own visibilities'
     /// share interpolated.
     indirect: DVec3,
-    /// Its smooth value, on `leaf` (NONE: in none), where the means say enough.
-    smooth: Option<DVec3>,
-    /// Its value by the leaf's look (`Gather::looked`), where that judged it instead.
-    looked: Option<DVec3>,
+    /// What judged it, on `leaf` (NONE: in none).
+    judged: Judged,
     leaf: u32,
     /// Vertex id once the edge is split.
     vertex: u32,
+}
+
+/// The value a midpoint was judged by.
+#[derive(Clone, Copy)]
+enum Judged {
+    /// In no leaf: not judged.
+    Not,
+    /// The smooth value (`Gather::smooth`), where the means say enough.
+    Smooth(DVec3),
+    /// The value by the leaf's look (`Gather::looked`).
+    Look(DVec3),
 }
 
 /// What the passes learn and keep: each edge's midpoint, and values at edge ends.
@@ -160,9 +172,9 @@ pub fn subdivide(
 
     let mut out = Subdivided {
         positions: el.positions.clone(),
-        eval: el.eval.clone(),
-        normals: el.normals.clone(),
-        vertex_face: el.vertex_face.clone(),
+        eval: Vec::new(),
+        normals: Vec::new(),
+        vertex_face: Vec::new(),
         direct: Vec::new(),
         indirect: indirect.to_vec(),
         triangles: el.triangles.clone(),
@@ -170,7 +182,30 @@ pub fn subdivide(
         tri_region: el.tri_region.clone(),
         passes: 0,
     };
-    let mut dir: Vec<DVec3> = direct.to_vec();
+    // Old vertices' attributes from `el` (and `direct`), added ones' from `out`.
+    let old = |v: usize| v < nv;
+    let eval_at = |out: &Subdivided, v: usize| if old(v) { el.eval[v] } else { out.eval[v - nv] };
+    let normal_at = |out: &Subdivided, v: usize| {
+        if old(v) {
+            el.normals[v]
+        } else {
+            out.normals[v - nv]
+        }
+    };
+    let face_at = |out: &Subdivided, v: usize| {
+        if old(v) {
+            el.vertex_face[v]
+        } else {
+            out.vertex_face[v - nv]
+        }
+    };
+    let direct_at = |out: &Subdivided, v: usize| {
+        if old(v) {
+            direct[v]
+        } else {
+            out.direct[v - nv]
+        }
+    };
     // Triangles by origin: the element triangle each one came from.
     let mut origin: Vec<u32> = (0..el.triangles.len() as u32).collect();
     let mut known = Known::default();
@@ -181,7 +216,7 @@ pub fn subdivide(
     let evaluate = |edges: &[((u32, u32), u32)],
                     out: &Subdivided,
                     origin: &[u32],
-                    adj: &HashMap<(u32, u32), Vec<u32>>,
+                    adj: &EdgeTris,
                     known: &mut Known| {
         let Known {
             mids,
@@ -202,7 +237,7 @@ pub fn subdivide(
         let mut sides: HashMap<(u32, u32), (Vec<u32>, u32)> = HashMap::new();
         for &(k, _) in &todo {
             let (mut r, mut leaf) = (Vec::new(), NONE);
-            for &t in adj.get(&k).map_or(&[][..], |v| &v[..]) {
+            for &t in adj.of(k) {
                 let o = origin[t as usize] as usize;
                 if !r.contains(&el.tri_region[o]) {
                     r.push(el.tri_region[o]);
@@ -218,7 +253,7 @@ pub fn subdivide(
             .map(|&((a, b), t)| {
                 let (a, b) = (a as usize, b as usize);
                 let p = (out.positions[a] + out.positions[b]) * 0.5;
-                let eval = (out.eval[a] + out.eval[b]) * 0.5;
+                let eval = (eval_at(out, a) + eval_at(out, b)) * 0.5;
                 let o = origin[t as usize] as usize;
                 let regions: Vec<&crate::regions::Region> = sides[&key(a as u32, b as u32)]
                     .0
@@ -230,7 +265,7 @@ pub fn subdivide(
                     &tolerances,
                     el.tri_face[o],
                     eval,
-                    out.normals[a],
+                    normal_at(out, a),
                     &regions,
                     &outlines,
                 );
@@ -282,7 +317,7 @@ pub fn subdivide(
                     continue;
                 }
                 slot[k] = *asked.entry((v, leaf)).or_insert_with(|| {
-                    points.push(point(out.eval[v as usize]));
+                    points.push(point(eval_at(out, v as usize)));
                     points.len() - 1
                 });
             }
@@ -347,7 +382,7 @@ pub fn subdivide(
         end_todo.dedup_by_key(|x| (x.0, x.1));
         let end_vals: Vec<((u32, u32), DVec3)> = end_todo
             .par_iter()
-            .map(|&(v, leaf, t)| ((v, leaf), at(out.eval[v as usize], leaf, t)))
+            .map(|&(v, leaf, t)| ((v, leaf), at(eval_at(out, v as usize), leaf, t)))
             .collect();
         seen_ends.extend(end_vals);
         let seen_ends = &*seen_ends;
@@ -370,17 +405,19 @@ pub fn subdivide(
             value[i] = v;
             by_leaf_look[i] = Some(m);
         }
-        for (i, (&((a, b), _), &(p, eval, e))) in todo.iter().zip(&lit).enumerate() {
+        for (i, (&((a, b), _), &(_, _, e))) in todo.iter().zip(&lit).enumerate() {
+            let judged = match (g[i], by_leaf_look[i]) {
+                (Some(m), _) => Judged::Smooth(m),
+                (None, Some(m)) => Judged::Look(m),
+                (None, None) => Judged::Not,
+            };
             mids.insert(
                 (a, b),
                 Mid {
-                    p,
-                    eval,
                     direct: e,
                     err: err[i],
                     indirect: value[i],
-                    smooth: g[i],
-                    looked: by_leaf_look[i],
+                    judged,
                     leaf: leaf_of[i],
                     vertex: NONE,
                 },
@@ -391,16 +428,7 @@ pub fn subdivide(
     let mut any = false;
     for _ in 0..MAX_PASSES {
         progress.check()?;
-        // Triangles around each edge, for this pass's mesh.
-        let mut adj: HashMap<(u32, u32), Vec<u32>> =
-            HashMap::with_capacity(out.triangles.len() * 2);
-        for (t, tri) in out.triangles.iter().enumerate() {
-            for i in 0..3 {
-                adj.entry(key(tri[i], tri[(i + 1) % 3]))
-                    .or_default()
-                    .push(t as u32);
-            }
-        }
+        let adj = EdgeTris::new(&out.triangles);
         // Edges whose ends differ, on triangles of a leaf, long enough to split.
         let mut cand: Vec<((u32, u32), u32)> = Vec::new();
         for (t, tri) in out.triangles.iter().enumerate() {
@@ -420,7 +448,11 @@ pub fn subdivide(
                     continue;
                 }
                 let d = (out.indirect[ua] - out.indirect[ub]).abs().element_sum();
-                let base = 0.5 * (dir[ua] + out.indirect[ua] + dir[ub] + out.indirect[ub]);
+                let base = 0.5
+                    * (direct_at(&out, ua)
+                        + out.indirect[ua]
+                        + direct_at(&out, ub)
+                        + out.indirect[ub]);
                 if d > SCREEN * tol * (base.element_sum() + floor) {
                     cand.push((k, t as u32));
                 }
@@ -438,7 +470,10 @@ pub fn subdivide(
                 let m = &known.mids[&k];
                 let (a, b) = (k.0 as usize, k.1 as usize);
                 let lin = 0.5 * (out.indirect[a] + out.indirect[b]);
-                let k = if m.smooth.is_none() { LOOK_SCALE } else { 1.0 };
+                let k = match m.judged {
+                    Judged::Smooth(_) => 1.0,
+                    _ => LOOK_SCALE,
+                };
                 m.err > k * tol * ((m.direct + lin).element_sum() + floor)
             })
             .map(|&(k, _)| k)
@@ -455,7 +490,7 @@ pub fn subdivide(
             progress.check()?;
             let mut more: Vec<((u32, u32), u32)> = Vec::new();
             for k in &frontier {
-                for &t in adj.get(k).map_or(&[][..], |v| &v[..]) {
+                for &t in adj.of(*k) {
                     let tri = &out.triangles[t as usize];
                     let l = longest(&out.positions, tri);
                     let kl = key(tri[l], tri[(l + 1) % 3]);
@@ -484,23 +519,22 @@ pub fn subdivide(
         for k in &split {
             let m = known.mids.get_mut(k).expect("evaluated above");
             m.vertex = out.positions.len() as u32;
-            let a = k.0 as usize;
-            out.positions.push(m.p);
-            out.eval.push(m.eval);
-            out.normals.push(out.normals[a]);
-            out.vertex_face.push(out.vertex_face[a]);
+            let (a, b) = (k.0 as usize, k.1 as usize);
+            let p = (out.positions[a] + out.positions[b]) * 0.5;
+            let eval = (eval_at(&out, a) + eval_at(&out, b)) * 0.5;
+            let (normal, face) = (normal_at(&out, a), face_at(&out, a));
+            out.positions.push(p);
+            out.eval.push(eval);
+            out.normals.push(normal);
+            out.vertex_face.push(face);
             out.indirect.push(m.indirect);
             // A new vertex is an end of the next pass's edges: its value there is known.
-            if m.leaf != NONE {
-                if let Some(g) = m.smooth {
-                    known.ends.insert((m.vertex, m.leaf), g);
-                }
-                if let Some(g) = m.looked {
-                    known.seen_ends.insert((m.vertex, m.leaf), g);
-                }
+            match m.judged {
+                Judged::Smooth(g) => _ = known.ends.insert((m.vertex, m.leaf), g),
+                Judged::Look(g) => _ = known.seen_ends.insert((m.vertex, m.leaf), g),
+                Judged::Not => {}
             }
             out.direct.push(m.direct);
-            dir.push(m.direct);
         }
         let vertex_of = |a: u32, b: u32| -> Option<u32> {
             known
@@ -519,6 +553,10 @@ pub fn subdivide(
         }
         out.triangles = tris;
         origin = orig;
+        // Split edges are gone from the mesh: their midpoints are vertices now.
+        for k in &split {
+            known.mids.remove(k);
+        }
         out.passes += 1;
         any = true;
     }
@@ -528,4 +566,34 @@ pub fn subdivide(
     out.tri_face = origin.iter().map(|&o| el.tri_face[o as usize]).collect();
     out.tri_region = origin.iter().map(|&o| el.tri_region[o as usize]).collect();
     Ok(Some(out))
+}
+
+/// The triangles around each edge of a mesh, by the edge's ends (smaller first): flat and
+/// sorted, as a map of small lists cost room-828 about 100 MB.
+struct EdgeTris {
+    keys: Vec<(u32, u32)>,
+    tris: Vec<u32>,
+}
+
+impl EdgeTris {
+    fn new(triangles: &[[u32; 3]]) -> Self {
+        let mut all: Vec<((u32, u32), u32)> = Vec::with_capacity(triangles.len() * 3);
+        for (t, tri) in triangles.iter().enumerate() {
+            for i in 0..3 {
+                let (a, b) = (tri[i], tri[(i + 1) % 3]);
+                all.push(((a.min(b), a.max(b)), t as u32));
+            }
+        }
+        // By edge, then by triangle: the order a map filled triangle by triangle gave.
+        all.par_sort_unstable();
+        let (keys, tris) = all.into_iter().unzip();
+        EdgeTris { keys, tris }
+    }
+
+    /// The triangles around the edge `k`, in index order (none if it is no edge).
+    fn of(&self, k: (u32, u32)) -> &[u32] {
+        let lo = self.keys.partition_point(|x| *x < k);
+        let hi = lo + self.keys[lo..].partition_point(|x| *x == k);
+        &self.tris[lo..hi]
+    }
 }
