@@ -248,11 +248,10 @@ pub fn subdivide(
             }
             sides.insert(k, (r, leaf));
         }
-        let lit: Vec<(DVec3, DVec3, DVec3)> = todo
+        let lit: Vec<(DVec3, DVec3)> = todo
             .par_iter()
             .map(|&((a, b), t)| {
                 let (a, b) = (a as usize, b as usize);
-                let p = (out.positions[a] + out.positions[b]) * 0.5;
                 let eval = (eval_at(out, a) + eval_at(out, b)) * 0.5;
                 let o = origin[t as usize] as usize;
                 let regions: Vec<&crate::regions::Region> = sides[&key(a as u32, b as u32)]
@@ -269,14 +268,13 @@ pub fn subdivide(
                     &regions,
                     &outlines,
                 );
-                (p, eval, e)
+                (eval, e)
             })
             .collect();
-        // Each midpoint and the edge's two ends, gathered smooth on the midpoint's leaf.
+        // A point a hair towards its leaf's centre, as the final gather places vertices.
         let nudge = |q: DVec3, leaf: u32| q + (h.nodes[leaf as usize].centroid - q) * 1e-6;
         // Each midpoint, and each edge end not yet known on that leaf, gathered smooth on
-        // the midpoint's leaf (an end serves the several edges around it).
-        // Leaves where links seen in part carry much of the light go to their own look
+        // the midpoint's leaf (an end serves the several edges around it). Leaves where links seen in part carry much of the light go to their own look
         // straight away: most of their edges' smooth values would give up.
         let mut new_leaves: Vec<u32> = todo
             .iter()
@@ -294,7 +292,7 @@ pub fn subdivide(
         let mut points: Vec<Point> = Vec::new();
         let mut asked: HashMap<(u32, u32), usize> = HashMap::new();
         let mut slots: Vec<[usize; 3]> = Vec::new();
-        for (i, (&((a, b), t), &(_, eval, _))) in todo.iter().zip(&lit).enumerate() {
+        for (i, (&((a, b), t), &(eval, _))) in todo.iter().zip(&lit).enumerate() {
             let leaf = sides[&(a, b)].1;
             if leaf == NONE {
                 continue;
@@ -392,7 +390,7 @@ pub fn subdivide(
             .map(|&(i, t)| {
                 let ((a, b), _) = todo[i];
                 let leaf = leaf_of[i];
-                let m = at(lit[i].1, leaf, t);
+                let m = at(lit[i].0, leaf, t);
                 let la = seen_ends[&(a, leaf)];
                 let lb = seen_ends[&(b, leaf)];
                 let err = (m - 0.5 * (la + lb)).abs().element_sum();
@@ -405,7 +403,7 @@ pub fn subdivide(
             value[i] = v;
             by_leaf_look[i] = Some(m);
         }
-        for (i, (&((a, b), _), &(_, _, e))) in todo.iter().zip(&lit).enumerate() {
+        for (i, (&((a, b), _), &(_, e))) in todo.iter().zip(&lit).enumerate() {
             let judged = match (g[i], by_leaf_look[i]) {
                 (Some(m), _) => Judged::Smooth(m),
                 (None, Some(m)) => Judged::Look(m),
