@@ -183,29 +183,10 @@ pub fn subdivide(
         passes: 0,
     };
     // Old vertices' attributes from `el` (and `direct`), added ones' from `out`.
-    let old = |v: usize| v < nv;
-    let eval_at = |out: &Subdivided, v: usize| if old(v) { el.eval[v] } else { out.eval[v - nv] };
-    let normal_at = |out: &Subdivided, v: usize| {
-        if old(v) {
-            el.normals[v]
-        } else {
-            out.normals[v - nv]
-        }
-    };
-    let face_at = |out: &Subdivided, v: usize| {
-        if old(v) {
-            el.vertex_face[v]
-        } else {
-            out.vertex_face[v - nv]
-        }
-    };
-    let direct_at = |out: &Subdivided, v: usize| {
-        if old(v) {
-            direct[v]
-        } else {
-            out.direct[v - nv]
-        }
-    };
+    let eval_at = |out: &Subdivided, v: usize| either(&el.eval, &out.eval, v);
+    let normal_at = |out: &Subdivided, v: usize| either(&el.normals, &out.normals, v);
+    let face_at = |out: &Subdivided, v: usize| either(&el.vertex_face, &out.vertex_face, v);
+    let direct_at = |out: &Subdivided, v: usize| either(direct, &out.direct, v);
     // Triangles by origin: the element triangle each one came from.
     let mut origin: Vec<u32> = (0..el.triangles.len() as u32).collect();
     let mut known = Known::default();
@@ -328,7 +309,7 @@ pub fn subdivide(
             }
         }
         let mut err = vec![0.0; todo.len()];
-        let mut g = vec![None; todo.len()];
+        let mut judged = vec![Judged::Not; todo.len()];
         let mut leaf_of = vec![NONE; todo.len()];
         // In no leaf (under a cover, buried), the interpolant, as its ends had.
         let mut value: Vec<DVec3> = todo
@@ -354,7 +335,7 @@ pub fn subdivide(
             // interpolated (as the mesh did before).
             let own = (out.indirect[a as usize] - ga) + (out.indirect[b as usize] - gb);
             value[i] = m + 0.5 * own;
-            g[i] = Some(m);
+            judged[i] = Judged::Smooth(m);
         }
         let none = LeafLook::default();
         let at = |q: DVec3, leaf: u32, t: u32| {
@@ -384,7 +365,6 @@ pub fn subdivide(
             .collect();
         seen_ends.extend(end_vals);
         let seen_ends = &*seen_ends;
-        let mut by_leaf_look = vec![None; todo.len()];
         let by_look: Vec<(usize, f64, DVec3, DVec3)> = looked
             .par_iter()
             .map(|&(i, t)| {
@@ -401,21 +381,16 @@ pub fn subdivide(
         for (i, e, v, m) in by_look {
             err[i] = e;
             value[i] = v;
-            by_leaf_look[i] = Some(m);
+            judged[i] = Judged::Look(m);
         }
         for (i, (&((a, b), _), &(_, e))) in todo.iter().zip(&lit).enumerate() {
-            let judged = match (g[i], by_leaf_look[i]) {
-                (Some(m), _) => Judged::Smooth(m),
-                (None, Some(m)) => Judged::Look(m),
-                (None, None) => Judged::Not,
-            };
             mids.insert(
                 (a, b),
                 Mid {
                     direct: e,
                     err: err[i],
                     indirect: value[i],
-                    judged,
+                    judged: judged[i],
                     leaf: leaf_of[i],
                     vertex: NONE,
                 },
@@ -564,6 +539,15 @@ pub fn subdivide(
     out.tri_face = origin.iter().map(|&o| el.tri_face[o as usize]).collect();
     out.tri_region = origin.iter().map(|&o| el.tri_region[o as usize]).collect();
     Ok(Some(out))
+}
+
+/// Vertex `v`'s value: of `old` while it is one of those, else of `added` after them.
+fn either<T: Copy>(old: &[T], added: &[T], v: usize) -> T {
+    if v < old.len() {
+        old[v]
+    } else {
+        added[v - old.len()]
+    }
 }
 
 /// The triangles around each edge of a mesh, by the edge's ends (smaller first): flat and

@@ -351,16 +351,14 @@ impl Gather<'_> {
             .map(|&(_, v)| self.el.positions[v as usize])
             .collect();
         if verts.len() <= ANCHORS || !unsure.iter().any(|u| u.varies) {
-            let at: Vec<(DVec3, Vec<f64>)> = verts
+            let (out, own): (Vec<(u32, DVec3)>, Vec<Vec<f64>>) = verts
                 .iter()
-                .map(|&(_, v)| self.at(v, leaf, chain, &unsure))
-                .collect();
-            let look = LeafLook::keep(&unsure, pos.iter().zip(&at).map(|(&p, a)| (p, a.1.clone())));
-            let out = verts
-                .iter()
-                .zip(at)
-                .map(|(&(_, v), (e, _))| (v, e))
-                .collect();
+                .map(|&(_, v)| {
+                    let (e, own) = self.at(v, leaf, chain, &unsure);
+                    ((v, e), own)
+                })
+                .unzip();
+            let look = LeafLook::keep(&unsure, pos.into_iter().zip(own));
             return (out, look);
         }
         let anchors = spread(&pos, ANCHORS);
