@@ -123,7 +123,18 @@ impl Visibility<'_> {
             .get(id as usize)
             .and_then(|&o| self.occluders.get(o as usize))
         {
-            Some(Occluder::Solid { solid, .. }) => solid_covers(solid, a, b, self.occ.tolerance()),
+            Some(Occluder::Solid { solid, .. }) => {
+                // The planar nodes' normals, turned from `r` towards `s`.
+                let mut normals = [DVec3::ZERO; 2];
+                let mut k = 0;
+                for (n, sign) in [(r, 1.0), (s, -1.0)] {
+                    if n.is_planar() {
+                        normals[k] = self.faces[n.face as usize].plane.n * sign;
+                        k += 1;
+                    }
+                }
+                solid_covers(solid, a, b, &normals[..k], self.occ.tolerance())
+            }
             _ => false,
         }
     }
@@ -246,26 +257,42 @@ impl Visibility<'_> {
 }
 
 /// Whether the convex `solid` hides every segment from a point of the hull of `a` to a point
-/// of the hull of `b`: both lie outside it (each wholly in front of one of its planes: a node
-/// partly buried in it sees out through its inside) and every such segment passes through
-/// its inside. A plane across the axis between the two, through the solid where it can,
-/// separates them; the segments cross it in the hull of the crossings of the segments
-/// between their points (`Occluders::face_covers`), and the solid, being convex, holds that
-/// hull if it holds those crossings, each more than `tol` inside.
-fn solid_covers(solid: &Solid, a: &[DVec3], b: &[DVec3], tol: f64) -> bool {
+/// of the hull of `b`. A plane that separates the two hulls is crossed by those segments in
+/// the hull of the crossings of the segments between their points (`Occluders::face_covers`);
+/// if the solid, being convex, holds those crossings, each more than `tol` inside, every
+/// segment passes through its inside, and it crosses a face of it on the way out to an end
+/// that lies wholly outside (in front of one of its planes). Only one end need be outside:
+/// from a node partly buried in the solid (clutter standing in clutter) every segment still
+/// leaves through a face; two buried ends could see each other inside it.
+///
+/// The plane is tried across the axis between the two and along the planes of the nodes
+/// that are planar (`normals`, pointing from `a` towards `b`): a box side standing beside the
+/// floor's node under it is not separated from it along the axis, but is along the floor's
+/// normal. On room-828 (clutter boxes standing in each other on a table) the buried ends
+/// and the normals spare 0.43M and 0.34M of 42.2M rays; most pairs whose rays were all
+/// blocked are hidden by several solids together, which no one of them covers (of the 2.1M
+/// dropped after a second look, 138k were covered by a face one of its rays hit).
+fn solid_covers(solid: &Solid, a: &[DVec3], b: &[DVec3], normals: &[DVec3], tol: f64) -> bool {
     let outside = |p: &[DVec3]| {
         solid
             .planes
             .iter()
             .any(|pl| p.iter().all(|&x| pl.dist(x) > tol))
     };
-    if !outside(a) || !outside(b) {
+    if !outside(a) && !outside(b) {
         return false;
     }
     let mean = |p: &[DVec3]| p.iter().copied().sum::<DVec3>() / p.len() as f64;
-    let Some(n) = (mean(b) - mean(a)).try_normalize() else {
-        return false;
-    };
+    let axis = (mean(b) - mean(a)).try_normalize();
+    axis.into_iter()
+        .chain(normals.iter().copied())
+        .any(|n| crossings_inside(solid, a, b, n, tol))
+}
+
+/// Whether the plane across `n` through the solid's centre (moved between `a` and `b` where
+/// that is outside the gap between them) separates the two and the segments between their
+/// points all cross it more than `tol` inside the solid.
+fn crossings_inside(solid: &Solid, a: &[DVec3], b: &[DVec3], n: DVec3, tol: f64) -> bool {
     let a_top = a
         .iter()
         .map(|p| n.dot(*p))
@@ -395,18 +422,34 @@ mod test {
         };
         // Across the box along x.
         let (a, b) = (tri(-1.0, 0.5, 0.5, 0.2), tri(2.0, 0.5, 0.5, 0.2));
-        assert!(solid_covers(solid, &a, &b, tol));
+        assert!(solid_covers(solid, &a, &b, &[], tol));
         // Wider than the box: a segment passes beside it.
-        assert!(!solid_covers(solid, &tri(-1.0, 0.5, 0.5, 0.9), &b, tol));
-        // One end partly inside: from there a segment sees out without crossing a face.
+        assert!(!solid_covers(
+            solid,
+            &tri(-1.0, 0.5, 0.5, 0.9),
+            &b,
+            &[],
+            tol
+        ));
+        // One end inside, or partly inside: every segment still leaves through a face.
         let buried = tri(0.1, 0.5, 0.5, 0.2);
-        assert!(!solid_covers(solid, &buried, &b, tol));
+        assert!(solid_covers(solid, &buried, &b, &[], tol));
+        let straddling = vec![
+            DVec3::new(-0.3, 0.4, 0.3),
+            DVec3::new(0.3, 0.6, 0.3),
+            DVec3::new(0.0, 0.5, 0.7),
+        ];
+        assert!(solid_covers(solid, &straddling, &b, &[], tol));
+        // Both ends inside: they see each other through its inside, crossing no face.
+        let deep = tri(0.9, 0.5, 0.5, 0.05);
+        assert!(!solid_covers(solid, &buried, &deep, &[], tol));
+        assert!(!occ.segment_blocked(buried[0], deep[1]));
         // Diagonally through two corners: every segment crosses it, though through two of
         // its faces, so no one face covers the pair.
         let (c, d) = (tri(-0.5, -0.5, 0.5, 0.05), tri(1.5, 1.5, 0.5, 0.05));
-        assert!(solid_covers(solid, &c, &d, tol));
+        assert!(solid_covers(solid, &c, &d, &[], tol));
         assert!((0..sc.faces.len() as u32).all(|f| !occ.face_covers(f, &c, &d)));
-        for (p, q) in [(&a, &b), (&c, &d)] {
+        for (p, q) in [(&a, &b), (&c, &d), (&buried, &b), (&straddling, &b)] {
             for &x in p.iter() {
                 for &y in q.iter() {
                     assert!(occ.segment_blocked(x, y));
