@@ -183,10 +183,10 @@ pub fn subdivide(
         passes: 0,
     };
     // Old vertices' attributes from `el` (and `direct`), added ones' from `out`.
-    let eval_at = |out: &Subdivided, v: usize| either(&el.eval, &out.eval, v);
-    let normal_at = |out: &Subdivided, v: usize| either(&el.normals, &out.normals, v);
-    let face_at = |out: &Subdivided, v: usize| either(&el.vertex_face, &out.vertex_face, v);
-    let direct_at = |out: &Subdivided, v: usize| either(direct, &out.direct, v);
+    let eval_at = |out: &Subdivided, v: usize| either(&el.eval, &out.eval, nv, v);
+    let normal_at = |out: &Subdivided, v: usize| either(&el.normals, &out.normals, nv, v);
+    let face_at = |out: &Subdivided, v: usize| either(&el.vertex_face, &out.vertex_face, nv, v);
+    let direct_at = |out: &Subdivided, v: usize| either(direct, &out.direct, nv, v);
     // Triangles by origin: the element triangle each one came from.
     let mut origin: Vec<u32> = (0..el.triangles.len() as u32).collect();
     let mut known = Known::default();
@@ -541,12 +541,14 @@ pub fn subdivide(
     Ok(Some(out))
 }
 
-/// Vertex `v`'s value: of `old` while it is one of those, else of `added` after them.
-fn either<T: Copy>(old: &[T], added: &[T], v: usize) -> T {
-    if v < old.len() {
+/// Vertex `v`'s value: of `old` for the `nv` old vertices, else of `added` after them. The
+/// split is by the vertex count, not by `old`'s length: an array shorter than the vertices
+/// must fail on its index, not hand an old vertex an added one's value.
+fn either<T: Copy>(old: &[T], added: &[T], nv: usize, v: usize) -> T {
+    if v < nv {
         old[v]
     } else {
-        added[v - old.len()]
+        added[v - nv]
     }
 }
 
