@@ -125,47 +125,74 @@ pub fn seen_from(
         return out;
     }
     let k = k.max(1);
-    for i in 0..k {
-        let r = mix(seed ^ mix(i as u64 + 1));
-        let (y, ny) = point_of(vis, table, s, (i as f64 + unit(r)) / k as f64, unit(mix(r)));
-        let (p, n) = match start {
-            Start::Point(p, n, _) => (p, n),
-            // The start's strata in another order (7 is prime to the powers of two the
-            // counts are), so that the pairs do not run side by side across the two nodes.
-            Start::Node(rn) => {
-                let j = (i as u64 * 7 + 3) % k as u64;
-                let q = mix(r ^ 0x5851_f42d_4c95_7f2d);
-                point_of(
-                    vis,
-                    table,
-                    rn,
-                    (j as f64 + unit(q)) / k as f64,
-                    unit(mix(q)),
-                )
+    // The points first, then the rays: finding a point misses cache (the area table's
+    // search, the corners, the vertices), and apart from the traversals the processor
+    // overlaps those misses across points.
+    let mut ends = [(DVec3::ZERO, DVec3::ZERO, DVec3::ZERO, DVec3::ZERO); BATCH];
+    for first in (0..k).step_by(BATCH) {
+        let last = (first + BATCH as u32).min(k);
+        for (i, e) in (first..last).zip(ends.iter_mut()) {
+            *e = segment_ends(vis, table, start, s, k, i, seed);
+        }
+        for &(p, n, y, ny) in &ends[..(last - first) as usize] {
+            let d = y - p;
+            let (ca, cb) = (n.dot(d), -ny.dot(d));
+            if !(ca > 0.0 && cb > 0.0) {
+                continue;
             }
-        };
-        let d = y - p;
-        let (ca, cb) = (n.dot(d), -ny.dot(d));
-        if !(ca > 0.0 && cb > 0.0) {
-            continue;
-        }
-        let d2 = d.length_squared();
-        let w = ca * cb / (d2 * d2);
-        if !w.is_finite() {
-            continue;
-        }
-        out.total += w;
-        out.total_sq += w * w;
-        out.rays += 1;
-        let blocked = match blockers {
-            Some(l) if l.len() <= MAX_LISTED => vis.occ.segment_blocked_by(p, y, l),
-            _ => vis.occ.segment_blocked_skip(p, y, &skip),
-        };
-        if !blocked {
-            out.open += w;
+            let d2 = d.length_squared();
+            let w = ca * cb / (d2 * d2);
+            if !w.is_finite() {
+                continue;
+            }
+            out.total += w;
+            out.total_sq += w * w;
+            out.rays += 1;
+            let blocked = match blockers {
+                Some(l) if l.len() <= MAX_LISTED => vis.occ.segment_blocked_by(p, y, l),
+                _ => vis.occ.segment_blocked_skip(p, y, &skip),
+            };
+            if !blocked {
+                out.open += w;
+            }
         }
     }
     out
+}
+
+/// Segments whose ends `seen_from` finds before it casts them.
+const BATCH: usize = 16;
+
+/// The ends of `seen_from`'s `i`-th of `k` segments from `start` to `s` (stream `seed`):
+/// start point and normal, end point and normal.
+fn segment_ends(
+    vis: &Visibility,
+    table: &AreaTable,
+    start: Start,
+    s: &Node,
+    k: u32,
+    i: u32,
+    seed: u64,
+) -> (DVec3, DVec3, DVec3, DVec3) {
+    let r = mix(seed ^ mix(i as u64 + 1));
+    let (y, ny) = point_of(vis, table, s, (i as f64 + unit(r)) / k as f64, unit(mix(r)));
+    let (p, n) = match start {
+        Start::Point(p, n, _) => (p, n),
+        // The start's strata in another order (7 is prime to the powers of two the
+        // counts are), so that the pairs do not run side by side across the two nodes.
+        Start::Node(rn) => {
+            let j = (i as u64 * 7 + 3) % k as u64;
+            let q = mix(r ^ 0x5851_f42d_4c95_7f2d);
+            point_of(
+                vis,
+                table,
+                rn,
+                (j as f64 + unit(q)) / k as f64,
+                unit(mix(q)),
+            )
+        }
+    };
+    (p, n, y, ny)
 }
 
 /// The point of node `n` at the fraction `u` of its area (`AreaTable`), the part of its
