@@ -51,6 +51,7 @@ use refine::Refiner;
 use solve::{Gathering, Leaves, Solver};
 use visibility::Visibility;
 
+use crate::geom::box_grid::{bounds, BoxGrid};
 use crate::geom::polygon::strictly_inside_convex;
 use crate::geom::raycast::Occluders;
 use crate::mesh::elements::Elements;
@@ -97,7 +98,10 @@ pub fn indirect(
     let nv = el.positions.len();
     super::check_direct(el, direct)?;
     let faces = &scene.faces;
-    let covers = crate::indirect::coplanar_contacts::covers(faces, 1e-6 * scene.diagonal());
+    let covers = Covers::new(crate::indirect::coplanar_contacts::covers(
+        faces,
+        1e-6 * scene.diagonal(),
+    ));
     let leaf_radius = LEAF_RADIUS * settings.patch_size;
     // From here on, faces include the backs of thin faces (`back`).
     let backs = back::Backs::new(scene, occ);
@@ -231,10 +235,42 @@ pub fn indirect(
     Ok(result)
 }
 
+/// The covers of each face (`coplanar_contacts::covers`: coplanar faces against it, facing
+/// the other way), with a grid over their boxes: a floor under thousands of boxes has
+/// thousands of covers, and trying each for every one of its triangles took room-8328's
+/// bake 7 s on one thread.
+struct Covers {
+    polys: Vec<Vec<Vec<DVec2>>>,
+    grids: Vec<Option<BoxGrid>>,
+}
+
+impl Covers {
+    fn new(polys: Vec<Vec<Vec<DVec2>>>) -> Self {
+        let grids = polys
+            .iter()
+            .map(|ps| {
+                let boxes: Vec<(DVec2, DVec2)> = ps.iter().map(|p| bounds(p)).collect();
+                (!boxes.is_empty()).then(|| BoxGrid::new(&boxes))
+            })
+            .collect();
+        Covers { polys, grids }
+    }
+
+    /// Whether `p` (in face `f`'s frame) lies strictly inside one of its covers.
+    fn hold(&self, f: usize, p: DVec2) -> bool {
+        let Some(grid) = &self.grids[f] else {
+            return false;
+        };
+        grid.at(p)
+            .iter()
+            .any(|&i| strictly_inside_convex(&self.polys[f][i as usize], p))
+    }
+}
+
 /// Whether element triangle `t` lies under a cover of its face (its centroid inside one).
-fn covered(scene: &Scene, el: &Elements, covers: &[Vec<Vec<DVec2>>], t: u32) -> bool {
+fn covered(scene: &Scene, el: &Elements, covers: &Covers, t: u32) -> bool {
     let f = el.tri_face[t as usize] as usize;
-    if covers[f].is_empty() {
+    if covers.grids[f].is_none() {
         return false;
     }
     let c = el.triangles[t as usize]
@@ -242,8 +278,7 @@ fn covered(scene: &Scene, el: &Elements, covers: &[Vec<Vec<DVec2>>], t: u32) -> 
         .map(|&v| el.positions[v as usize])
         .sum::<DVec3>()
         / 3.0;
-    let p = scene.faces[f].frame.to_2d(c);
-    covers[f].iter().any(|poly| strictly_inside_convex(poly, p))
+    covers.hold(f, scene.faces[f].frame.to_2d(c))
 }
 
 /// Per leaf position: direct irradiance (the mean of its corners'), albedo, π·Le.

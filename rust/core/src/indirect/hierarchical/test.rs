@@ -741,3 +741,42 @@ fn cancelled_bake_stops() {
     );
     assert_eq!(r, Err(BakeError::Cancelled));
 }
+
+/// `Covers::hold` (a grid over the covers' boxes) answers as trying every cover does, on a
+/// face under 200 small covers, some overlapping, at points inside, outside and on their
+/// edges.
+#[test]
+fn covers_by_grid_answer_as_every_cover_does() {
+    use crate::geom::hash::{mix, unit};
+    let r = |i: u64| unit(mix(i));
+    let polys: Vec<Vec<DVec2>> = (0..200u64)
+        .map(|i| {
+            let c = DVec2::new(10.0 * r(4 * i), 10.0 * r(4 * i + 1));
+            let (w, h) = (0.05 + 0.5 * r(4 * i + 2), 0.05 + 0.5 * r(4 * i + 3));
+            vec![
+                c,
+                c + DVec2::new(w, 0.0),
+                c + DVec2::new(w, h),
+                c + DVec2::new(0.0, h),
+            ]
+        })
+        .collect();
+    let covers = Covers::new(vec![Vec::new(), polys.clone()]);
+    let (mut inside, mut on_edge) = (0, 0);
+    for i in 0..20_000u64 {
+        // Every fourth point on the left edge of a cover, where the strict test says no.
+        let p = if i % 4 == 0 {
+            let q = &polys[(i / 4) as usize % polys.len()];
+            q[0] + (q[3] - q[0]) * r(9 * i + 7)
+        } else {
+            DVec2::new(11.0 * r(9 * i) - 0.5, 11.0 * r(9 * i + 1) - 0.5)
+        };
+        let every = polys.iter().any(|q| strictly_inside_convex(q, p));
+        assert_eq!(covers.hold(1, p), every, "point {p:?}");
+        assert!(!covers.hold(0, p));
+        inside += every as u32;
+        on_edge += (i % 4 == 0 && !every) as u32;
+    }
+    assert!(inside > 1000, "{inside} points inside");
+    assert!(on_edge > 1000, "{on_edge} points on an edge and outside");
+}
