@@ -45,6 +45,7 @@ mod visibility;
 use std::f64::consts::PI;
 
 use glam::{DVec2, DVec3};
+use rayon::prelude::*;
 
 use hierarchy::Hierarchy;
 use refine::Refiner;
@@ -107,7 +108,13 @@ pub fn indirect(
     let backs = back::Backs::new(scene, occ);
     let faces: &[crate::scene::Face] = &backs.faces;
     let buried = buried::Buried::new(scene, 1e-6 * scene.diagonal());
-    let keep = |t| !covered(scene, el, &covers, t) && !buried.buried(el, t);
+    // Decided for every triangle up front, on all threads: the hierarchy's build asks in
+    // turn (room-8328: 2.5 s of one thread, perf).
+    let kept: Vec<bool> = (0..el.triangles.len() as u32)
+        .into_par_iter()
+        .map(|t| !covered(scene, el, &covers, t) && !buried.buried(el, t))
+        .collect();
+    let keep = |t: u32| kept[t as usize];
     let mut h = Hierarchy::build_two_sided(faces, el, keep, leaf_radius, &backs.of);
     h.set_boxes(faces, el);
     let nl = h.order.len();
