@@ -56,12 +56,18 @@ pub(super) fn check_faces(
         }
     }
     kinds.resize(cdt.num_vertices(), Kind::Unknown);
-    for &f in &faces {
-        for v in view.vertices(f) {
-            if kinds[v.index()] == Kind::Unknown {
-                kinds[v.index()] = view.kind(v);
-            }
-        }
+    // On a floor under thousands of shadows this receiver is the last one meshed, alone on
+    // one thread (room-8328), and a vertex's kind walks its D0 edges: found on all threads.
+    let mut unknown: Vec<FixedVertexHandle> = faces
+        .iter()
+        .flat_map(|&f| view.vertices(f))
+        .filter(|v| kinds[v.index()] == Kind::Unknown)
+        .collect();
+    unknown.sort_unstable();
+    unknown.dedup();
+    let found: Vec<Kind> = unknown.par_iter().map(|&v| view.kind(v)).collect();
+    for (v, k) in unknown.into_iter().zip(found) {
+        kinds[v.index()] = k;
     }
     let kinds = &*kinds;
     let readings: Vec<[DVec2; 3]> = faces
@@ -92,6 +98,7 @@ pub(super) fn check_faces(
         })
         .collect();
     stats.evaluations += values.len() as u64;
+    cache.reserve(todo.len());
     for (&(p, _, _), val) in todo.iter().zip(values) {
         *brightest = brightest.max(val.0);
         cache.insert(key(p), val);
@@ -200,6 +207,7 @@ pub(super) fn check_faces(
             })
             .collect();
         stats.evaluations += values.len() as u64;
+        cache.reserve(todo.len());
         for (&(q, _, _), val) in todo.iter().zip(values) {
             cache.insert(key(q), val);
         }

@@ -3,6 +3,7 @@
 
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
+use spade::handles::FixedUndirectedEdgeHandle;
 use spade::Triangulation;
 
 use super::sides::{nudge, sides, D0Test, Edge, Face};
@@ -174,28 +175,21 @@ pub(super) fn extract_with(
         }
         test.is_d0(e, ca, cb, &regions)
     };
-    // Asked again for every edge around each D0 vertex: decided once per edge.
-    let d0_known: Vec<std::cell::Cell<u8>> =
-        vec![std::cell::Cell::new(0); cdt.num_undirected_edges()];
-    let is_d0_edge = |e: Edge<'_>| -> bool {
-        if !e.is_constraint_edge() {
-            return false;
-        }
-        let known = &d0_known[e.as_undirected().index()];
-        if known.get() != 0 {
-            return known.get() == 2;
-        }
-        let d0 = is_d0_uncached(e);
-        known.set(if d0 { 2 } else { 1 });
-        d0
-    };
+    // Asked again for every edge around each D0 vertex: decided once per edge, on all
+    // threads (a floor under thousands of shadows is meshed last, alone: room-8328).
+    let edges: Vec<FixedUndirectedEdgeHandle> = cdt.fixed_undirected_edges().collect();
+    let d0_flag: Vec<bool> = edges
+        .into_par_iter()
+        .map(|h| {
+            let e = cdt.undirected_edge(h);
+            e.is_constraint_edge() && is_d0_uncached(e.as_directed())
+        })
+        .collect();
+    let is_d0_edge = |e: Edge<'_>| -> bool { d0_flag[e.as_undirected().index()] };
     let mut d0_vertices = Vec::new();
     for e in cdt.undirected_edges() {
-        if !e.is_constraint_edge() {
-            continue;
-        }
-        let d = e.as_directed();
-        if is_d0_edge(d) {
+        if d0_flag[e.index()] {
+            let d = e.as_directed();
             d0_vertices.push(d.from().fix());
             d0_vertices.push(d.to().fix());
         }
@@ -204,8 +198,12 @@ pub(super) fn extract_with(
     let mut d0_corners = Vec::new();
     d0_vertices.sort_unstable();
     d0_vertices.dedup();
-    for vh in d0_vertices {
-        let Some(s) = sides(cdt, vh, shift, &is_d0_edge, &inside) else {
+    let found: Vec<_> = d0_vertices
+        .par_iter()
+        .map(|&vh| sides(cdt, vh, shift, &is_d0_edge, &inside))
+        .collect();
+    for (vh, s) in d0_vertices.into_iter().zip(found) {
+        let Some(s) = s else {
             continue;
         };
         if !s.straight {
