@@ -79,20 +79,23 @@ pub struct Solver<'a> {
     /// Cluster index of each node (`NONE` for planar nodes).
     pub cluster: Vec<u32>,
     clusters: usize,
+    /// The node of each cluster.
+    cluster_node: Vec<u32>,
 }
 
 impl<'a> Solver<'a> {
     pub fn new(h: &'a Hierarchy, faces: &'a [Face], g: &'a Gathering) -> Self {
-        let mut clusters = 0;
+        let mut cluster_node = Vec::new();
         let cluster = h
             .nodes
             .iter()
-            .map(|n| {
+            .enumerate()
+            .map(|(i, n)| {
                 if n.is_planar() {
                     NONE
                 } else {
-                    clusters += 1;
-                    clusters as u32 - 1
+                    cluster_node.push(i as u32);
+                    cluster_node.len() as u32 - 1
                 }
             })
             .collect();
@@ -101,7 +104,8 @@ impl<'a> Solver<'a> {
             faces,
             g,
             cluster,
-            clusters,
+            clusters: cluster_node.len(),
+            cluster_node,
         }
     }
 
@@ -154,18 +158,28 @@ impl<'a> Solver<'a> {
 
     fn pull(&self, leaves: &Leaves, e: &[DVec3]) -> Radiosity {
         let h = self.h;
-        let mut mean = vec![DVec3::ZERO; h.nodes.len()];
-        let mut table = vec![[[DVec3::ZERO; 2]; 3]; self.clusters];
-        for i in (0..h.nodes.len()).rev() {
-            let n = &h.nodes[i];
-            if n.is_leaf() {
+        // Leaves on all threads, then the nodes above them from the bottom up.
+        let mut mean: Vec<DVec3> = h
+            .nodes
+            .par_iter()
+            .with_min_len(256)
+            .map(|n| {
+                if !n.is_leaf() {
+                    return DVec3::ZERO;
+                }
                 let sum: DVec3 = (n.lo as usize..n.hi as usize)
                     .map(|p| {
                         (leaves.albedo[p] * (leaves.direct[p] + e[p]) + leaves.emitted[p])
                             * h.area[p]
                     })
                     .sum();
-                mean[i] = sum / n.area.max(1e-300);
+                sum / n.area.max(1e-300)
+            })
+            .collect();
+        let mut table = vec![[[DVec3::ZERO; 2]; 3]; self.clusters];
+        for i in (0..h.nodes.len()).rev() {
+            let n = &h.nodes[i];
+            if n.is_leaf() {
                 continue;
             }
             let [a, b] = n.kids.map(|k| k as usize);
@@ -217,65 +231,89 @@ impl<'a> Solver<'a> {
             .sum()
     }
 
-    /// Per node: scalar irradiance (planar) or, for a cluster, the irradiance arriving along
-    /// each axis from either side, `[axis][0: towards +, 1: towards −]` (a vector sum would
-    /// cancel light from below against light from above).
-    fn gather(&self, b: &Radiosity) -> Vec<(DVec3, Dirs)> {
-        (0..self.h.nodes.len())
+    /// Per node, scalar irradiance (zero for a cluster); per cluster, the irradiance
+    /// arriving along each axis from either side, `[axis][0: towards +, 1: towards −]` (a
+    /// vector sum would cancel light from below against light from above). Apart because a
+    /// cluster's six vectors, held for every node, were 168 bytes a node each sweep (room-8328:
+    /// the solve's fresh pages were much of its time).
+    fn gather(&self, b: &Radiosity) -> (Vec<DVec3>, Vec<Dirs>) {
+        let links =
+            |r: usize| &self.g.links[self.g.start[r] as usize..self.g.start[r + 1] as usize];
+        let e = (0..self.h.nodes.len())
             .into_par_iter()
             .with_min_len(256)
             .map(|r| {
-                let ls = &self.g.links[self.g.start[r] as usize..self.g.start[r + 1] as usize];
                 let mut e = DVec3::ZERO;
-                let mut ev: Dirs = [[DVec3::ZERO; 2]; 3];
-                let planar = self.cluster[r] == NONE;
-                for l in ls {
-                    let x = self.sent(b, l.source, l.u) * l.k as f64;
-                    if planar {
-                        e += x;
-                    } else {
-                        for ax in 0..3 {
-                            let c = l.u[ax] as f64;
-                            ev[ax][usize::from(c < 0.0)] += x * c.abs();
-                        }
+                if self.cluster[r] == NONE {
+                    for l in links(r) {
+                        e += self.sent(b, l.source, l.u) * l.k as f64;
                     }
                 }
-                (e, ev)
+                e
             })
-            .collect()
+            .collect();
+        let dirs = self
+            .cluster_node
+            .par_iter()
+            .with_min_len(64)
+            .map(|&r| {
+                let mut ev: Dirs = [[DVec3::ZERO; 2]; 3];
+                for l in links(r as usize) {
+                    let x = self.sent(b, l.source, l.u) * l.k as f64;
+                    for ax in 0..3 {
+                        let c = l.u[ax] as f64;
+                        ev[ax][usize::from(c < 0.0)] += x * c.abs();
+                    }
+                }
+                ev
+            })
+            .collect();
+        (e, dirs)
     }
 
     /// Indirect irradiance per leaf position from every node's gathered irradiance.
-    fn push(&self, got: &[(DVec3, Dirs)]) -> Vec<DVec3> {
+    fn push(&self, (got, got_dirs): &(Vec<DVec3>, Vec<Dirs>)) -> Vec<DVec3> {
         let h = self.h;
-        let mut acc: Vec<(DVec3, Dirs)> = vec![(DVec3::ZERO, [[DVec3::ZERO; 2]; 3]); h.nodes.len()];
+        const ZERO: Dirs = [[DVec3::ZERO; 2]; 3];
+        let dirs_of = |ds: &[Dirs], i: usize| match self.cluster[i] {
+            NONE => ZERO,
+            c => ds[c as usize],
+        };
+        let mut acc = vec![DVec3::ZERO; h.nodes.len()];
+        let mut acc_dirs = vec![ZERO; self.clusters];
         if !h.nodes.is_empty() {
             acc[0] = got[0];
             if h.nodes[0].is_planar() {
-                acc[0].0 += self.along(0, &got[0].1);
+                acc[0] += self.along(0, &ZERO);
+            } else {
+                acc_dirs[0] = got_dirs[0];
             }
         }
         let mut out = vec![DVec3::ZERO; h.order.len()];
         for i in 0..h.nodes.len() {
             let n = &h.nodes[i];
             if n.is_leaf() {
-                out[n.lo as usize..n.hi as usize].fill(acc[i].0);
+                out[n.lo as usize..n.hi as usize].fill(acc[i]);
                 continue;
             }
+            let above = dirs_of(&acc_dirs, i);
             for k in n.kids {
                 let k = k as usize;
-                let mut a = (acc[i].0 + got[k].0, [[DVec3::ZERO; 2]; 3]);
+                let mut a = acc[i] + got[k];
                 if h.nodes[k].is_planar() {
                     // Where a face begins, the clusters' vectors above become irradiance.
                     if !n.is_planar() {
-                        a.0 += self.along(k, &acc[i].1);
+                        a += self.along(k, &above);
                     }
                 } else {
+                    let own = dirs_of(got_dirs, k);
+                    let mut d = ZERO;
                     for ax in 0..3 {
                         for side in 0..2 {
-                            a.1[ax][side] = acc[i].1[ax][side] + got[k].1[ax][side];
+                            d[ax][side] = above[ax][side] + own[ax][side];
                         }
                     }
+                    acc_dirs[self.cluster[k] as usize] = d;
                 }
                 acc[k] = a;
             }
