@@ -262,7 +262,7 @@ pub fn subdivide(
             .map(|(k, _)| sides[k].1)
             .filter(|&l| l != NONE && !partly.contains_key(&l))
             .collect();
-        new_leaves.sort_unstable();
+        new_leaves.par_sort_unstable();
         new_leaves.dedup();
         let found: Vec<(u32, bool)> = new_leaves
             .par_iter()
@@ -357,7 +357,7 @@ pub fn subdivide(
                 }
             }
         }
-        end_todo.sort_unstable();
+        end_todo.par_sort_unstable();
         end_todo.dedup_by_key(|x| (x.0, x.1));
         let end_vals: Vec<((u32, u32), DVec3)> = end_todo
             .par_iter()
@@ -431,7 +431,7 @@ pub fn subdivide(
                 }
             }
         }
-        cand.sort_unstable();
+        cand.par_sort_unstable();
         cand.dedup_by_key(|x| x.0);
         if cand.is_empty() {
             break;
@@ -475,7 +475,7 @@ pub fn subdivide(
             if more.is_empty() {
                 break;
             }
-            more.sort_unstable();
+            more.par_sort_unstable();
             more.dedup_by_key(|x| x.0);
             evaluate(&more, &out, &origin, &adj, &mut known);
             frontier.clear();
@@ -488,7 +488,7 @@ pub fn subdivide(
         if out.positions.len() + split.len() > max_vertices {
             break;
         }
-        split.sort_unstable();
+        split.par_sort_unstable();
         for k in &split {
             let m = known.mids.get_mut(k).expect("evaluated above");
             m.vertex = out.positions.len() as u32;
