@@ -47,6 +47,8 @@ pub struct Stats {
     pub T_lop: f64,
     pub T_lit: f64,
     pub T_div: f64,
+    /// Meshing: its share by CPU time of the pass that builds each receiver's regions and
+    /// then its mesh (the region sub-stages T_idd…T_div share the rest), plus assembling.
     pub T_m: f64,
     pub T_direct: f64,
     pub T_rs: f64,
@@ -449,7 +451,8 @@ fn weld(scene: &Scene, tol: &Tolerances, el: &Elements, colors: &[[f64; 3]]) -> 
     // Vertices sorted by (mesh, rounded position), then each run of one key welded in index
     // order, on all threads: each vertex stands for itself or for the first earlier vertex
     // of its run that it may join and that stands for itself. A map of runs filled vertex
-    // by vertex gave the same and was seconds on one thread for room-8328's 6M vertices.
+    // by vertex gave the same on one thread, in the last seconds of room-8328's bake where
+    // one core idled (6M vertices).
     let mut keyed: Vec<((u32, [i64; 3]), u32)> = (0..el.positions.len())
         .into_par_iter()
         .map(|v| {
