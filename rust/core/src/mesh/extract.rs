@@ -176,7 +176,8 @@ pub(super) fn extract_with(
         test.is_d0(e, ca, cb, &regions)
     };
     // Asked again for every edge around each D0 vertex: decided once per edge, on all
-    // threads (a floor under thousands of shadows is meshed last, alone: room-8328).
+    // threads (a receiver under thousands of shadows holds one thread for its whole mesh
+    // but for what it splits itself: room-8328's table top).
     let edges: Vec<FixedUndirectedEdgeHandle> = cdt.fixed_undirected_edges().collect();
     let d0_flag: Vec<bool> = edges
         .into_par_iter()
