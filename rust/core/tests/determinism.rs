@@ -17,10 +17,16 @@ fn one_and_four_threads_agree_bit_for_bit() {
     ];
     let mut s = scene(meshes, lights, Default::default());
     let mut out = Vec::new();
+    let mut counts = Vec::new();
     for threads in [1, 4] {
         s.settings.threads = Some(threads);
         let b = bake(&s);
         out.push(serde_json::to_string(&b.meshes).unwrap());
+        let st = &b.stats;
+        counts.push([st.N_links, st.rays, st.N_hidden, st.gather_rays]);
     }
     assert_eq!(out[0], out[1]);
+    // The work is the same too: links, refinement's rays and the final gather's.
+    assert_eq!(counts[0], counts[1]);
+    assert!(counts[0][1] > 0 && counts[0][3] > 0, "{:?}", counts[0]);
 }

@@ -69,6 +69,9 @@ pub struct Stats {
     pub N_hidden: u64,
     pub T_link: f64,
     pub T_gather: f64,
+    /// Hierarchical solver: visibility rays the final gather cast (`rays` counts
+    /// refinement's only).
+    pub gather_rays: u64,
     /// Vertex×light pairs: skipped in umbra, computed unoccluded in lit regions, computed
     /// with visibility in penumbra.
     pub pairs_umbra: u64,
@@ -375,6 +378,7 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
         stats.N_hidden = ind.hidden;
         stats.T_link = ind.t_refine;
         stats.T_gather = ind.t_gather;
+        stats.gather_rays = ind.gather_rays;
         for (e, i) in irradiance.iter_mut().zip(&ind.irradiance) {
             *e += *i;
         }
@@ -567,7 +571,7 @@ fn output(scene: &Scene, tol: &Tolerances, el: &Elements, colors: &[[f64; 3]]) -
 /// The stats as a text table in the layout of the paper's Tables 2 and 4.
 pub fn stats_table(s: &Stats) -> String {
     let mut t = String::new();
-    let rows: [(&str, String); 31] = [
+    let rows: [(&str, String); 32] = [
         ("receivers before loop split  N_f1", s.N_f1.to_string()),
         ("faces after loop split       N_f2", s.N_f2.to_string()),
         ("discontinuity edges          N_d", s.N_d.to_string()),
@@ -629,6 +633,7 @@ pub fn stats_table(s: &Stats) -> String {
             "  final gather         T_gather (s)",
             format!("{:.4}", s.T_gather),
         ),
+        ("  final gather's rays", s.gather_rays.to_string()),
         (
             "bytes per leaf (hierarchy+links)",
             format!("{:.0}", s.bytes_per_leaf),

@@ -80,6 +80,9 @@ pub struct IndirectResult {
     pub hidden: u64,
     pub t_refine: f64,
     pub t_gather: f64,
+    /// Hierarchical solver only: visibility rays the final gather cast (leaves' and
+    /// vertices' own looks at their links' sources).
+    pub gather_rays: u64,
     /// Hierarchical solver only: the element mesh split where indirect light curves, with
     /// `irradiance` then per vertex of that mesh.
     pub subdivided: Option<hierarchical::subdivide::Subdivided>,

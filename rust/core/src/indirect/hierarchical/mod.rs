@@ -231,6 +231,7 @@ pub fn indirect(
         }
     }
     result.t_gather = t_gather.elapsed().as_secs_f64();
+    result.gather_rays = gather.rays();
     if settings.ambient {
         let amb = ambient(&h, &leaves, sol.last_delta);
         at.iter_mut().for_each(|e| *e += amb);

@@ -85,11 +85,13 @@ pub(super) fn own_visibility(
     lv: f64,
     seed: u64,
     screened: Option<Seen>,
-) -> (f64, bool) {
+) -> (f64, bool, u32) {
     // Nothing between the leaf and the source: all of it is in sight.
     if blockers.is_some_and(|l| l.is_empty()) {
-        return (1.0, false);
+        return (1.0, false, 0);
     }
+    // Rays cast here (not those of `screened`), for the stats.
+    let mut rays = 0;
     let varies = |seen: &Seen| seen.open > 0.0 && seen.open < seen.total;
     let mut seen = Seen::default();
     let mut cast = 0;
@@ -97,27 +99,24 @@ pub(super) fn own_visibility(
     // A link whose rays all agreed (lv 0 or 1) is screened first by a few rays: if they all
     // agree too, the link's value stands.
     if lv == 0.0 || lv == 1.0 {
-        seen = screened
-            .unwrap_or_else(|| seen_from(vis, table, start, s, blockers, SCREEN_RAYS, seed));
+        seen = screened.unwrap_or_else(|| {
+            let x = seen_from(vis, table, start, s, blockers, SCREEN_RAYS, seed);
+            rays += x.rays;
+            x
+        });
         cast = SCREEN_RAYS;
         match seen.fraction() {
             Some(v) if v != lv => k = REPLACE_RAYS - SCREEN_RAYS,
-            _ => return (lv, false),
+            _ => return (lv, false, rays),
         }
     }
     for round in 1u64.. {
-        seen.add(seen_from(
-            vis,
-            table,
-            start,
-            s,
-            blockers,
-            k,
-            mix(seed ^ round),
-        ));
+        let more = seen_from(vis, table, start, s, blockers, k, mix(seed ^ round));
+        rays += more.rays;
+        seen.add(more);
         cast += k;
         let Some(v) = seen.fraction() else {
-            return (lv, false);
+            return (lv, false, rays);
         };
         let d = (v - lv).abs();
         let var = (lv * (1.0 - lv)).max(v * (1.0 - v)) / seen.effective().max(1.0);
@@ -130,11 +129,11 @@ pub(super) fn own_visibility(
         };
         if z <= NOISE || z >= SURE || cast >= MAX_VERTEX_RAYS {
             let t = ((z - NOISE) / (SURE - NOISE)).clamp(0.0, 1.0);
-            return (lv + (v - lv) * t * t * (3.0 - 2.0 * t), varies(&seen));
+            return (lv + (v - lv) * t * t * (3.0 - 2.0 * t), varies(&seen), rays);
         }
         k = cast.min(MAX_VERTEX_RAYS - cast);
     }
-    (lv, false)
+    (lv, false, rays)
 }
 
 #[cfg(test)]

@@ -29,6 +29,7 @@
 //! sees more of its near side, and a fraction of the whole says nothing of which.
 
 use std::collections::HashMap;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -100,7 +101,14 @@ impl<'a> Gather<'a> {
             tolerance,
             table: AreaTable::new(h),
             parent,
+            rays: AtomicU64::new(0),
         }
+    }
+
+    /// Visibility rays the final gather has cast so far (segments whose ends faced each
+    /// other; the same count for any thread count).
+    pub fn rays(&self) -> u64 {
+        self.rays.load(Ordering::Relaxed)
     }
 
     /// Leaf nodes and their ancestors, from the leaf up.
@@ -311,6 +319,8 @@ pub struct Gather<'a> {
     tolerance: f64,
     table: AreaTable,
     parent: Vec<u32>,
+    /// Rays cast so far (`rays`).
+    rays: AtomicU64,
 }
 
 /// A link above a leaf from a planar source whose visibility is a mean (`Link::clear`
@@ -427,11 +437,14 @@ impl Gather<'_> {
                 // screens agree, and the shaft's blocker list pays only over more rays.
                 let screened = (u.v == 1.0)
                     .then(|| seen_from(self.vis, &self.table, start, s, None, SCREEN_RAYS, seed));
+                if let Some(x) = screened {
+                    self.rays.fetch_add(x.rays as u64, Ordering::Relaxed);
+                }
                 if screened.is_some_and(|x| x.fraction().is_none_or(|f| f == u.v)) {
                     continue;
                 }
                 let list = self.vis.blockers(ln, s);
-                let (v, varies) = own_visibility(
+                let (v, varies, rays) = own_visibility(
                     self.vis,
                     &self.table,
                     start,
@@ -441,6 +454,7 @@ impl Gather<'_> {
                     seed,
                     screened,
                 );
+                self.rays.fetch_add(rays as u64, Ordering::Relaxed);
                 (u.v, u.varies, u.blockers) = (v, varies, Some(list));
             }
         }
@@ -558,7 +572,9 @@ impl Gather<'_> {
             let list = u.blockers.as_ref().and_then(|b| b.as_deref());
             let seed = mix(mix(key) ^ u.source as u64);
             let start = Start::Point(p, n, face);
-            let (own, _) = own_visibility(self.vis, &self.table, start, s, list, u.v, seed, None);
+            let (own, _, rays) =
+                own_visibility(self.vis, &self.table, start, s, list, u.v, seed, None);
+            self.rays.fetch_add(rays as u64, Ordering::Relaxed);
             e += xs[i] * (own - u.v);
             used[i] = own;
         }
