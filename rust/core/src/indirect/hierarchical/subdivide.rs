@@ -170,8 +170,9 @@ pub fn subdivide(
     let tolerances = scene.tolerances();
     let outlines = crate::direct::outlines(scene);
 
-    // The copies on all threads: each of room-8328's is 20–140 MB of fresh pages, and
-    // made on one thread they were 2.5 s of one core busy after its final gather.
+    // The copies on all threads: each of room-8328's is 20–140 MB of fresh pages. Made on
+    // one thread, they fell in 2.5 s with one core busy after its final gather, most of it
+    // the kernel clearing fresh pages (a 50 Hz timeline).
     let copy = |x: &[u32]| -> Vec<u32> { x.par_iter().copied().collect() };
     let copy3 = |x: &[DVec3]| -> Vec<DVec3> { x.par_iter().copied().collect() };
     let mut out = Subdivided {
