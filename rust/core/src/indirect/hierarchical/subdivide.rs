@@ -170,21 +170,16 @@ pub fn subdivide(
     let tolerances = scene.tolerances();
     let outlines = crate::direct::outlines(scene);
 
-    // The copies on all threads: each of room-8328's is 20–140 MB of fresh pages. Made on
-    // one thread, they fell in 2.5 s with one core busy after its final gather, most of it
-    // the kernel clearing fresh pages (a 50 Hz timeline).
-    let copy = |x: &[u32]| -> Vec<u32> { x.par_iter().copied().collect() };
-    let copy3 = |x: &[DVec3]| -> Vec<DVec3> { x.par_iter().copied().collect() };
     let mut out = Subdivided {
-        positions: copy3(&el.positions),
+        positions: par_copy(&el.positions),
         eval: Vec::new(),
         normals: Vec::new(),
         vertex_face: Vec::new(),
         direct: Vec::new(),
-        indirect: copy3(indirect),
-        triangles: el.triangles.par_iter().copied().collect(),
-        tri_face: copy(&el.tri_face),
-        tri_region: copy(&el.tri_region),
+        indirect: par_copy(indirect),
+        triangles: par_copy(&el.triangles),
+        tri_face: par_copy(&el.tri_face),
+        tri_region: par_copy(&el.tri_region),
         passes: 0,
     };
     // Old vertices' attributes from `el` (and `direct`), added ones' from `out`.
@@ -544,6 +539,13 @@ pub fn subdivide(
     out.tri_face = origin.iter().map(|&o| el.tri_face[o as usize]).collect();
     out.tri_region = origin.iter().map(|&o| el.tri_region[o as usize]).collect();
     Ok(Some(out))
+}
+
+/// A copy made on all threads: each of room-8328's arrays is 20–140 MB of fresh pages.
+/// Made on one thread, the copies fell in 2.5 s with one core busy after its final gather,
+/// most of it the kernel clearing fresh pages (a 50 Hz timeline).
+fn par_copy<T: Copy + Send + Sync>(x: &[T]) -> Vec<T> {
+    x.par_iter().copied().collect()
 }
 
 /// Vertex `v`'s value: of `old` for the `nv` old vertices, else of `added` after them. The
