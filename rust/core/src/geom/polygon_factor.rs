@@ -57,6 +57,7 @@ use std::sync::OnceLock;
 
 use glam::DVec3;
 
+use super::lambert::angle;
 use super::plane::newell_normal;
 use super::polygon::clip_polygon_3d_into;
 use super::Plane;
@@ -383,21 +384,6 @@ fn p2(x: f64, h: f64) -> f64 {
     let lg = if r2 > 0.0 { r2.ln() } else { 0.0 };
     let at = if h > 0.0 { h * x * (x / h).atan() } else { 0.0 };
     0.25 * (x * x - h * h) * lg - 0.75 * x * x + at
-}
-
-/// `atan2(y, x)` for `y ≥ 0`, through `atan`: libm's `atan2` took twice as long, and this
-/// is the inner loop.
-#[inline]
-fn angle(y: f64, x: f64) -> f64 {
-    if x > 0.0 {
-        (y / x).atan()
-    } else if x < 0.0 {
-        PI - (y / -x).atan()
-    } else if y > 0.0 {
-        0.5 * PI
-    } else {
-        0.0
-    }
 }
 
 /// `I_q(x) = ∫_q ln |x − y| dt` in closed form.
