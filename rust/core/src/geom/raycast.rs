@@ -158,11 +158,31 @@ impl Occluders {
     /// [`segment_blocked_skip`](Self::segment_blocked_skip), with the face that blocks (the
     /// first the traversal finds).
     pub fn segment_blocker_skip(&self, a: DVec3, b: DVec3, skip: &[u32]) -> Option<u32> {
+        self.segment_blocker_hinted(a, b, skip, None)
+    }
+
+    /// [`segment_blocker_skip`](Self::segment_blocker_skip), trying the face `hint` first:
+    /// of a run of segments between two patches, most that are blocked are blocked by the
+    /// face that blocked the one before (a box between them), and one exact test spares a
+    /// traversal. The traversal finds every face that crosses (the boxes are padded), so
+    /// whether the segment is blocked is the same with any hint; which face, not always.
+    pub fn segment_blocker_hinted(
+        &self,
+        a: DVec3,
+        b: DVec3,
+        skip: &[u32],
+        hint: Option<u32>,
+    ) -> Option<u32> {
         let bvh = self.wide.as_ref()?;
         let d = b - a;
         let len = d.length();
         if !(len > self.tol) || !len.is_finite() {
             return None;
+        }
+        if let Some(f) = hint.filter(|f| !skip.contains(f)) {
+            if self.face_crosses_segment(f, a, b) {
+                return Some(f);
+            }
         }
         let ray = wide_ray(self.bvh_ray(a, d / len, len)?);
         let mut found = None;
@@ -187,6 +207,19 @@ impl Occluders {
             .iter()
             .copied()
             .find(|&f| self.face_crosses_segment(f, a, b))
+    }
+
+    /// [`segment_blocker_among`](Self::segment_blocker_among), trying `hint` (one of
+    /// `faces`) first, as [`segment_blocker_hinted`](Self::segment_blocker_hinted) does.
+    pub fn segment_blocker_among_hinted(
+        &self,
+        a: DVec3,
+        b: DVec3,
+        faces: &[u32],
+        hint: Option<u32>,
+    ) -> Option<u32> {
+        hint.filter(|&f| self.face_crosses_segment(f, a, b))
+            .or_else(|| self.segment_blocker_among(a, b, faces))
     }
 
     /// Whether face `id` blocks every segment from a point of the convex hull of `a` to a
@@ -734,6 +767,9 @@ pub(crate) mod test {
             (s >> 11) as f64 / (1u64 << 53) as f64
         };
         let mut hits = 0;
+        // The face that blocked the segment before, as the callers hint (it crosses some
+        // segments and not others), and a face to skip.
+        let (mut last, mut hinted) = (None, 0);
         for _ in 0..2000 {
             let a = v(rnd() * 9.0 - 1.0, rnd() * 9.0 - 1.0, rnd() * 4.0 - 1.5);
             let b = v(rnd() * 9.0 - 1.0, rnd() * 9.0 - 1.0, rnd() * 4.0 - 1.5);
@@ -743,8 +779,24 @@ pub(crate) mod test {
             let mut cand = Vec::new();
             o.candidates(a.min(b), a.max(b), &[], &[], &mut cand);
             assert_eq!(o.segment_blocked_by(a, b, &cand), brute);
+            let hit = o.segment_blocker_hinted(a, b, &[], last);
+            assert_eq!(hit.is_some(), brute);
+            hinted += (hit.is_some() && hit == last) as u32;
+            let hint = last.filter(|f| cand.contains(f));
+            let among = o.segment_blocker_among_hinted(a, b, &cand, hint);
+            assert_eq!(among.is_some(), brute);
+            // A hint that is skipped is not taken.
+            let skip = [last.unwrap_or(0)];
+            let unskipped =
+                (0..faces.len() as u32).any(|f| f != skip[0] && o.face_crosses_segment(f, a, b));
+            assert_eq!(
+                o.segment_blocker_hinted(a, b, &skip, last).is_some(),
+                unskipped
+            );
+            last = hit.or(last);
         }
         assert!(hits > 200 && hits < 1800, "{hits}");
+        assert!(hinted > 0, "no segment was blocked by its hint");
     }
 
     #[test]

@@ -129,6 +129,8 @@ pub fn seen_from(
     // search, the corners, the vertices), and apart from the traversals the processor
     // overlaps those misses across points.
     let mut ends = [(DVec3::ZERO, DVec3::ZERO, DVec3::ZERO, DVec3::ZERO); BATCH];
+    // The face that blocked the last blocked segment, tried first on the next.
+    let mut hint = None;
     for first in (0..k).step_by(BATCH) {
         let last = (first + BATCH as u32).min(k);
         for (i, e) in (first..last).zip(ends.iter_mut()) {
@@ -148,12 +150,16 @@ pub fn seen_from(
             out.total += w;
             out.total_sq += w * w;
             out.rays += 1;
-            let blocked = match blockers {
-                Some(l) if l.len() <= MAX_LISTED => vis.occ.segment_blocked_by(p, y, l),
-                _ => vis.occ.segment_blocked_skip(p, y, &skip),
+            let hit = match blockers {
+                Some(l) if l.len() <= MAX_LISTED => {
+                    vis.occ.segment_blocker_among_hinted(p, y, l, hint)
+                }
+                _ => vis.occ.segment_blocker_hinted(p, y, &skip, hint),
             };
-            if !blocked {
+            if hit.is_none() {
                 out.open += w;
+            } else {
+                hint = hit;
             }
         }
     }

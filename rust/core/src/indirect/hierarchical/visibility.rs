@@ -172,13 +172,19 @@ impl Visibility<'_> {
         // on faces turned away would be hidden by the box itself, and counting them would
         // dim a link whose light all comes from the faces turned towards the receiver.
         // Candidates are drawn from a longer fixed sequence until `k` such segments are found.
-        let mut first = None;
+        // The first face found blocking (a hint for the pairs below), and the last, tried
+        // first on the next segment: the first is found before any hint, so it is the one
+        // the traversal finds.
+        let (mut first, mut last) = (None, None);
         let mut blocked = |a: DVec3, b: DVec3| {
             let hit = match list {
-                Some(l) if l.len() <= MAX_LISTED => self.occ.segment_blocker_among(a, b, l),
-                _ => self.occ.segment_blocker_skip(a, b, &skip),
+                Some(l) if l.len() <= MAX_LISTED => {
+                    self.occ.segment_blocker_among_hinted(a, b, l, last)
+                }
+                _ => self.occ.segment_blocker_hinted(a, b, &skip, last),
             };
             first = first.or(hit);
+            last = hit.or(last);
             hit.is_some()
         };
         // Each segment counts by its own point-to-point factor cosθ·cosθs / d²: the part
