@@ -22,7 +22,7 @@
 use glam::DVec3;
 
 use super::hierarchy::{Hierarchy, Node};
-use super::visibility::{Visibility, MAX_LISTED};
+use super::visibility::Visibility;
 use crate::geom::hash::{mix, unit};
 
 /// Cumulative area of the leaf positions (`Hierarchy::order`): position `p` spans
@@ -150,12 +150,7 @@ pub fn seen_from(
             out.total += w;
             out.total_sq += w * w;
             out.rays += 1;
-            let hit = match blockers {
-                Some(l) if l.len() <= MAX_LISTED => {
-                    vis.occ.segment_blocker_among_hinted(p, y, l, hint)
-                }
-                _ => vis.occ.segment_blocker_hinted(p, y, &skip, hint),
-            };
+            let hit = vis.blocker(p, y, blockers, &skip, hint);
             if hit.is_none() {
                 out.open += w;
             } else {

@@ -90,6 +90,25 @@ impl Visibility<'_> {
             .collect()
     }
 
+    /// The face that blocks the segment `a`–`b`: among `list` where it is short enough, else
+    /// through the BVH past the faces `skip`; `hint` tried first
+    /// (`Occluders::segment_blocker_hinted`).
+    pub fn blocker(
+        &self,
+        a: DVec3,
+        b: DVec3,
+        list: Option<&[u32]>,
+        skip: &[u32],
+        hint: Option<u32>,
+    ) -> Option<u32> {
+        match list {
+            Some(l) if l.len() <= MAX_LISTED => {
+                self.occ.segment_blocker_among_hinted(a, b, l, hint)
+            }
+            _ => self.occ.segment_blocker_hinted(a, b, skip, hint),
+        }
+    }
+
     /// Fraction of `rays` segments between points of `r` and `s` that nothing blocks; 1
     /// without a ray when nothing can be in the way. Also returns the rays cast.
     #[cfg(test)]
@@ -177,12 +196,7 @@ impl Visibility<'_> {
         // the traversal finds.
         let (mut first, mut last) = (None, None);
         let mut blocked = |a: DVec3, b: DVec3| {
-            let hit = match list {
-                Some(l) if l.len() <= MAX_LISTED => {
-                    self.occ.segment_blocker_among_hinted(a, b, l, last)
-                }
-                _ => self.occ.segment_blocker_hinted(a, b, &skip, last),
-            };
+            let hit = self.blocker(a, b, list, &skip, last);
             first = first.or(hit);
             last = hit.or(last);
             hit.is_some()
