@@ -201,7 +201,8 @@ impl Occluders {
         found
     }
 
-    /// [`segment_blocked_by`](Self::segment_blocked_by), with the face that blocks.
+    /// The first of `faces` that crosses the open segment `a`–`b`: for callers that already
+    /// know the few faces that could be in the way.
     pub fn segment_blocker_among(&self, a: DVec3, b: DVec3, faces: &[u32]) -> Option<u32> {
         faces
             .iter()
@@ -246,12 +247,6 @@ impl Occluders {
                 f.edges.iter().all(|(m, c)| m.dot(x) - c > self.tol)
             })
         })
-    }
-
-    /// True if one of `faces` crosses the open segment `a`–`b`: for callers that already
-    /// know the few faces that could be in the way.
-    pub fn segment_blocked_by(&self, a: DVec3, b: DVec3, faces: &[u32]) -> bool {
-        self.segment_blocker_among(a, b, faces).is_some()
     }
 
     /// Signed distance of `p` from face `id`'s plane.
@@ -778,7 +773,7 @@ pub(crate) mod test {
             hits += brute as u32;
             let mut cand = Vec::new();
             o.candidates(a.min(b), a.max(b), &[], &[], &mut cand);
-            assert_eq!(o.segment_blocked_by(a, b, &cand), brute);
+            assert_eq!(o.segment_blocker_among(a, b, &cand).is_some(), brute);
             let hit = o.segment_blocker_hinted(a, b, &[], last);
             assert_eq!(hit.is_some(), brute);
             hinted += (hit.is_some() && hit == last) as u32;
