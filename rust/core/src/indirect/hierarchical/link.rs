@@ -470,6 +470,12 @@ const POINT_DEPTH: u32 = 4;
 /// distance: the disc estimate is off by about the square of that ratio.
 const POINT_NEAR: f64 = 0.3;
 
+/// Whether node `s` is near a point `d2` (squared) from its centroid, for `POINT_NEAR`:
+/// squared, since this runs for every link at every gathered point.
+fn point_near(s: &Node, d2: f64) -> bool {
+    0.25 * (s.hi_box - s.lo_box).length_squared() > POINT_NEAR * POINT_NEAR * d2
+}
+
 /// Irradiance at the point `p` (normal `n`) from the planar node `s` (normal `ns`) with
 /// node radiosities `b`, visibility not included: as `planar_factor`, but where a near
 /// source is split each part sends its own radiosity, not the source's mean (the floor
@@ -485,7 +491,7 @@ pub fn planar_gather(
 ) -> DVec3 {
     let node = &h.nodes[s as usize];
     let d2 = (node.centroid - p).length_squared();
-    if node.radius() > POINT_NEAR * d2.sqrt() {
+    if point_near(node, d2) {
         if node.is_leaf() {
             return b[s as usize] * exact_factor(h, el, p, n, node, ns);
         }
@@ -510,11 +516,10 @@ fn planar_factor(
     ns: DVec3,
     depth: u32,
 ) -> f64 {
-    let d = s.centroid - p;
-    let d2 = d.length_squared();
+    let d2 = (s.centroid - p).length_squared();
     // Far sources (small for their distance) take the disc estimate, off by about
     // (radius / distance)²; near ones are split, down to their triangles.
-    if s.radius() > POINT_NEAR * d2.sqrt() {
+    if point_near(s, d2) {
         if s.is_leaf() || s.hi - s.lo <= EXACT_LEAVES {
             return exact_factor(h, el, p, n, s, ns);
         }
@@ -607,5 +612,5 @@ fn kernel_mean(p: DVec3, n: DVec3, area: f64, c: DVec3, moment: &[f64; 6], ns: D
     let iq2 = iq * iq;
     let k0 = h * a * iq2;
     let hess = h * iq2 * iq * (-8.0 * n.dot(mw) - 4.0 * a * trace + 24.0 * a * w.dot(mw) * iq);
-    (area * (k0 + 0.5 * hess) / std::f64::consts::PI).max(0.0)
+    (area * (k0 + 0.5 * hess) * std::f64::consts::FRAC_1_PI).max(0.0)
 }
