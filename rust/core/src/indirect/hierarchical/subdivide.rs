@@ -190,6 +190,7 @@ pub fn subdivide(
     // Triangles by origin: the element triangle each one came from.
     let mut origin: Vec<u32> = (0..el.triangles.len() as u32).collect();
     let mut known = Known::default();
+    let gathered_on = gather.leaf_of();
     let max_vertices = nv + MAX_ADDED_PER_VERTEX * nv;
     let key = |a: u32, b: u32| (a.min(b), a.max(b));
 
@@ -359,9 +360,22 @@ pub fn subdivide(
         }
         end_todo.par_sort_unstable();
         end_todo.dedup_by_key(|x| (x.0, x.1));
+        // An old vertex on the leaf and face it was gathered on has that value already: the
+        // final gather's, by the same look (a pass's first `looked` calls were half of them).
         let end_vals: Vec<((u32, u32), DVec3)> = end_todo
             .par_iter()
-            .map(|&(v, leaf, t)| ((v, leaf), at(eval_at(out, v as usize), leaf, t)))
+            .map(|&(v, leaf, t)| {
+                let u = v as usize;
+                let gathered = u < nv
+                    && gathered_on[u] == leaf
+                    && el.vertex_face[u] == el.tri_face[origin[t as usize] as usize];
+                let e = if gathered {
+                    indirect[u]
+                } else {
+                    at(eval_at(out, u), leaf, t)
+                };
+                ((v, leaf), e)
+            })
             .collect();
         seen_ends.extend(end_vals);
         let seen_ends = &*seen_ends;
