@@ -54,6 +54,11 @@ impl Node {
     pub fn radius(&self) -> f64 {
         0.5 * (self.hi_box - self.lo_box).length()
     }
+
+    /// `radius` squared, without the square root (for tests run per link and point).
+    pub fn radius_squared(&self) -> f64 {
+        0.25 * (self.hi_box - self.lo_box).length_squared()
+    }
 }
 
 #[derive(Debug, Clone, Default)]

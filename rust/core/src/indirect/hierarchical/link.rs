@@ -473,7 +473,7 @@ const POINT_NEAR: f64 = 0.3;
 /// Whether node `s` is near a point `d2` (squared) from its centroid, for `POINT_NEAR`:
 /// squared, since this runs for every link at every gathered point.
 fn point_near(s: &Node, d2: f64) -> bool {
-    0.25 * (s.hi_box - s.lo_box).length_squared() > POINT_NEAR * POINT_NEAR * d2
+    s.radius_squared() > POINT_NEAR * POINT_NEAR * d2
 }
 
 /// Irradiance at the point `p` (normal `n`) from the planar node `s` (normal `ns`) with
