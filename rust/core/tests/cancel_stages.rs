@@ -91,30 +91,53 @@ fn cancel_returns_within_a_second_in_every_stage() {
 /// assembled: 4-63 ms from cancel to return in a debug build).
 /// (Called from the test above, not a test of its own: two bakes at once in one process
 /// share rayon's pool, and one bake's long tasks then delay the other's return.)
+/// This scene's direct stage takes about 20 ms (T_direct 0.018 s): a watcher that wakes a few ms
+/// late (two cores busy with the bake) can cancel after the stage's last check, and the
+/// bake then finishes (seen once at three quarters, in a full `scripts/test`). Such a try
+/// says nothing of the stage, so the fraction is tried again, up to `TRIES` times; a bake
+/// that ignored cancels there would finish every time.
 fn cancel_returns_within_a_second_anywhere_in_the_direct_stage(scene: &penumbra::Scene) {
+    const TRIES: u32 = 5;
     for at in [0.0, 0.25, 0.5, 0.75] {
-        let p = Arc::new(Progress::new());
-        let q = p.clone();
-        let watcher = std::thread::spawn(move || loop {
-            let (stage, f) = q.get();
-            if stage == "direct light" && f >= at {
-                q.cancel();
-                return Some(Instant::now());
+        let mut finished = 0;
+        loop {
+            let p = Arc::new(Progress::new());
+            let q = p.clone();
+            let watcher = std::thread::spawn(move || loop {
+                let (stage, f) = q.get();
+                if stage == "direct light" && f >= at {
+                    q.cancel();
+                    return Some(Instant::now());
+                }
+                if q.is_cancelled() {
+                    return None;
+                }
+                std::thread::sleep(Duration::from_micros(200));
+            });
+            let r = penumbra::bake(scene, &p);
+            let returned = Instant::now();
+            p.cancel();
+            let Some(cancelled_at) = watcher.join().unwrap() else {
+                panic!(
+                    "{at}: the bake finished before the cancel (ok: {})",
+                    r.is_ok()
+                );
+            };
+            if r.is_ok() {
+                finished += 1;
+                assert!(
+                    finished < TRIES,
+                    "{at}: the bake finished {finished} times though cancelled in its direct stage"
+                );
+                continue;
             }
-            if q.is_cancelled() {
-                return None;
-            }
-            std::thread::sleep(Duration::from_micros(200));
-        });
-        let r = penumbra::bake(scene, &p);
-        let returned = Instant::now();
-        p.cancel();
-        let Some(cancelled_at) = watcher.join().unwrap() else {
-            panic!("{at}: the bake finished before the cancel ({r:?})");
-        };
-        assert_eq!(r.unwrap_err(), BakeError::Cancelled, "{at}");
-        let took = returned.saturating_duration_since(cancelled_at);
-        eprintln!("direct light cancelled at {at}: returned in {took:?}");
-        assert!(took < Duration::from_secs(1), "{at}: cancel took {took:?}");
+            assert_eq!(r.unwrap_err(), BakeError::Cancelled, "{at}");
+            let took = returned.saturating_duration_since(cancelled_at);
+            eprintln!(
+                "direct light cancelled at {at}: returned in {took:?} (finished first: {finished})"
+            );
+            assert!(took < Duration::from_secs(1), "{at}: cancel took {took:?}");
+            break;
+        }
     }
 }
