@@ -19,8 +19,8 @@
 //! for holed and non-convex regions too.
 //!
 //! # Precision
-//! Angles come from `atan2(|a × b|, a · b)` (by `angle`), which is accurate for edges seen under tiny
-//! angles (where `acos` of a dot product loses half the digits). Edge vectors are taken from
+//! Angles come from `atan2(|a × b|, a · b)` (by `angle`), which is accurate for edges seen
+//! under tiny angles (where `acos` of a dot product loses half the digits). Edge vectors are taken from
 //! the caller's coordinates before moving the origin to `p`, so a polygon of size `s` at
 //! distance `d` keeps its shape to relative `ε`; what remains is the cancellation between
 //! opposite edges inherent in the contour sum, a relative error of about `ε · d / s`

@@ -152,20 +152,15 @@ impl Occluders {
     /// As [`segment_blocked`](Self::segment_blocked), ignoring the faces in `skip` (say the
     /// shooter's and the receiver's own faces, which cannot block but cost a test).
     pub fn segment_blocked_skip(&self, a: DVec3, b: DVec3, skip: &[u32]) -> bool {
-        self.segment_blocker_skip(a, b, skip).is_some()
+        self.segment_blocker_hinted(a, b, skip, None).is_some()
     }
 
-    /// [`segment_blocked_skip`](Self::segment_blocked_skip), with the face that blocks (the
-    /// first the traversal finds).
-    pub fn segment_blocker_skip(&self, a: DVec3, b: DVec3, skip: &[u32]) -> Option<u32> {
-        self.segment_blocker_hinted(a, b, skip, None)
-    }
-
-    /// [`segment_blocker_skip`](Self::segment_blocker_skip), trying the face `hint` first:
-    /// of a run of segments between two patches, most that are blocked are blocked by the
-    /// face that blocked the one before (a box between them), and one exact test spares a
-    /// traversal. The traversal finds every face that crosses (the boxes are padded), so
-    /// whether the segment is blocked is the same with any hint; which face, not always.
+    /// [`segment_blocked_skip`](Self::segment_blocked_skip), with the face that blocks (with
+    /// no hint, the first the traversal finds), trying the face `hint` first: of a run of
+    /// segments between two patches, most that are blocked are blocked by the face that
+    /// blocked the one before (a box between them), and one exact test spares a traversal.
+    /// The traversal finds every face that crosses (the boxes are padded), so whether the
+    /// segment is blocked is the same with any hint; which face, not always.
     pub fn segment_blocker_hinted(
         &self,
         a: DVec3,

@@ -239,7 +239,6 @@ fn point_of(vis: &Visibility, table: &AreaTable, n: &Node, u: f64, v: f64) -> (D
 #[cfg(test)]
 mod test {
     use super::*;
-    use crate::geom::hash::{mix, unit};
 
     #[test]
     fn a_large_range_finds_the_position_a_plain_search_finds() {
