@@ -139,6 +139,30 @@ def test_tolerance_setting_refines_and_is_checked():
     assert (e.kind, e.field) == ("setting", "tolerance")
 
 
+def test_vertex_values_are_fitted_unless_asked_for_exact():
+    # Under a square light the floor's light is concave near its peak, so linear
+    # interpolation of the exact vertex values reads low between them: the fit lifts the
+    # vertices there, on the same mesh, each by at most 0.4 × tolerance × (light + floor).
+    baked = {}
+    for mode in ("fitted", "exact"):
+        scene = plane_under_square_light()
+        scene["settings"]["vertex_values"] = mode
+        baked[mode] = _core.bake(scene)["meshes"][0]
+    f, e = baked["fitted"], baked["exact"]
+    assert np.array_equal(f["positions"], e["positions"])
+    assert np.array_equal(f["triangles"], e["triangles"])
+    fc, ec = f["colors"].astype(np.float64), e["colors"].astype(np.float64)
+    centre = np.argmin(np.linalg.norm(f["positions"][:, :2], axis=1))
+    assert fc[centre, 0] > ec[centre, 0]
+    assert fc.sum() > ec.sum()
+    bound = 0.4 * 0.01 * (ec + 0.01 * ec.max(axis=0)) * (1 + 1e-5) + 1e-7
+    assert (np.abs(fc - ec) <= bound).all()
+    scene = plane_under_square_light()
+    scene["settings"]["vertex_values"] = "sampled"
+    e = error_of(scene)
+    assert (e.kind, e.field) == ("setting", "vertex_values")
+
+
 def test_errors_arrive_through_the_job_too():
     scene = plane_under_square_light()
     scene["settings"]["element_size"] = -1.0

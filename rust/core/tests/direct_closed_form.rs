@@ -20,6 +20,8 @@ fn penumbra_values_match_rectangle_difference() {
         penumbra::scene::json::SettingsJson {
             indirect: Some(false),
             lighting_only: Some(true),
+            // The light at the vertices themselves, against the closed form there.
+            vertex_values: Some("exact".into()),
             ..Default::default()
         },
     );

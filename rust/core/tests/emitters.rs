@@ -19,6 +19,8 @@ fn settings(indirect: bool) -> SettingsJson {
     SettingsJson {
         indirect: Some(indirect),
         lighting_only: Some(true),
+        // The light at the vertices themselves, against the closed form there.
+        vertex_values: Some("exact".into()),
         ..Default::default()
     }
 }

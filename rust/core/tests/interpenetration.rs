@@ -16,6 +16,8 @@ fn settings(h: f64) -> SettingsJson {
         penumbra_element_size: Some(h / 4.0),
         indirect: Some(false),
         lighting_only: Some(true),
+        // The light at the vertices themselves, against the references there.
+        vertex_values: Some("exact".into()),
         ..Default::default()
     }
 }

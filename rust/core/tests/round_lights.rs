@@ -19,6 +19,8 @@ fn settings() -> SettingsJson {
     SettingsJson {
         indirect: Some(false),
         lighting_only: Some(true),
+        // The light at the vertices themselves, against the references there.
+        vertex_values: Some("exact".into()),
         // Finer than the sun's penumbra (0.09 wide under the box's top edge).
         penumbra_element_size: Some(0.03),
         ..Default::default()

@@ -40,6 +40,8 @@ fn clutter_scene() -> penumbra::SceneJson {
         SettingsJson {
             indirect: Some(false),
             lighting_only: Some(true),
+            // The light at the vertices themselves, which screening must not change.
+            vertex_values: Some("exact".into()),
             ..Default::default()
         },
     )

@@ -15,10 +15,11 @@ use super::ReceiverMesh;
 use crate::scene::Tolerances;
 
 /// Gives every triangle at a D0 line end (of `d0_lines`, or where the D0 rows of the split
-/// end or turn) its own vertex there (after the D0 row split).
-pub(crate) fn split(m: &mut ReceiverMesh, d0_lines: &[[DVec2; 2]], tol: &Tolerances) {
+/// end or turn) its own vertex there (after the D0 row split). Returns which vertices are
+/// such corners (empty when there are none).
+pub(crate) fn split(m: &mut ReceiverMesh, d0_lines: &[[DVec2; 2]], tol: &Tolerances) -> Vec<bool> {
     if m.d0_corners.is_empty() || m.positions.is_empty() {
-        return;
+        return Vec::new();
     }
     let scale = m
         .positions
@@ -48,9 +49,9 @@ pub(crate) fn split(m: &mut ReceiverMesh, d0_lines: &[[DVec2; 2]], tol: &Toleran
             })
         })
     };
-    let corner: Vec<bool> = m.positions.iter().map(|p| is_corner(*p)).collect();
+    let mut corner: Vec<bool> = m.positions.iter().map(|p| is_corner(*p)).collect();
     if !corner.iter().any(|&c| c) {
-        return;
+        return Vec::new();
     }
     // The first triangle met keeps the vertex; the others get copies.
     let mut taken = vec![false; m.positions.len()];
@@ -66,6 +67,7 @@ pub(crate) fn split(m: &mut ReceiverMesh, d0_lines: &[[DVec2; 2]], tol: &Toleran
             } else {
                 m.positions.push(m.positions[v]);
                 m.eval.push(m.positions[v]);
+                corner.push(true);
                 m.positions.len() - 1
             };
             m.triangles[t][k] = id as u32;
@@ -77,4 +79,5 @@ pub(crate) fn split(m: &mut ReceiverMesh, d0_lines: &[[DVec2; 2]], tol: &Toleran
             }
         }
     }
+    corner
 }

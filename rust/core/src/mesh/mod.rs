@@ -10,6 +10,7 @@ mod corner_split;
 mod doubt;
 pub mod elements;
 mod extract;
+mod fit;
 mod lattice;
 mod readings;
 pub mod refine;

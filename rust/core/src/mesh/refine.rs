@@ -24,10 +24,10 @@ use super::check::check_faces;
 use super::extract::{components, extract_with, face_index, scale, Components};
 use super::readings::{Kind, View};
 use super::sides::{D0Test, Face};
-use super::{corner_split, split, Cdt, Label, ReceiverMesh};
+use super::{corner_split, fit, split, Cdt, Label, ReceiverMesh};
 use crate::geom::Frame;
 use crate::regions::{ReceiverRegions, Region};
-use crate::scene::settings::Settings;
+use crate::scene::settings::{Settings, VertexValues};
 use crate::scene::Tolerances;
 use crate::BakeError;
 
@@ -332,8 +332,12 @@ pub(crate) fn refine(
             outside,
         },
     );
-    corner_split::split(&mut m, &rr.d0_lines, tol);
-    Ok(finish(m, &cache, stats))
+    let corner = corner_split::split(&mut m, &rr.d0_lines, tol);
+    let (mut m, mut stats) = finish(m, &cache, stats);
+    if settings.vertex_values == VertexValues::Fitted {
+        stats.evaluations += fit::fit(&mut m, &corner, &cache, lights, settings.tolerance);
+    }
+    Ok((m, stats))
 }
 
 /// Whether every edge that is not a constraint joins faces whose labels stand for the same

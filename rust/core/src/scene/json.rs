@@ -125,6 +125,10 @@ pub struct SettingsJson {
     pub lighting_only: Option<bool>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub penumbra_visibility: Option<String>,
+    /// "fitted" (default: the least-squares fit of the direct light over the elements
+    /// around each vertex) or "exact" (the light at the vertex).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vertex_values: Option<String>,
     /// "progressive" (default: progressive refinement over patches) or "hierarchical"
     /// (hierarchical radiosity with clustering, for large scenes).
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -12,6 +12,15 @@ pub enum PenumbraVisibility {
     Sampled,
 }
 
+/// What the direct light at an element vertex is (`mesh::fit`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VertexValues {
+    /// The least-squares fit of the light over the elements around the vertex.
+    Fitted,
+    /// The exact light at the vertex.
+    Exact,
+}
+
 /// How indirect light is solved (`indirect`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum IndirectSolver {
@@ -42,6 +51,8 @@ pub struct Settings {
     pub ambient: bool,
     pub lighting_only: bool,
     pub penumbra_visibility: PenumbraVisibility,
+    /// Refined meshes only: `meshing: uniform` has exact vertex values.
+    pub vertex_values: VertexValues,
     pub indirect_solver: IndirectSolver,
     /// Mesh uniformly instead of along discontinuities (for comparisons).
     pub uniform: bool,
@@ -143,6 +154,16 @@ impl Settings {
                 ))
             }
         };
+        let vertex_values = match s.vertex_values.as_deref() {
+            None | Some("fitted") => VertexValues::Fitted,
+            Some("exact") => VertexValues::Exact,
+            Some(o) => {
+                return Err(BakeError::setting(
+                    "vertex_values",
+                    format!("{o:?} is not \"fitted\" or \"exact\""),
+                ))
+            }
+        };
         let indirect_solver = match s.indirect_solver.as_deref() {
             Some("progressive") => IndirectSolver::Progressive,
             None | Some("hierarchical") => IndirectSolver::Hierarchical,
@@ -202,6 +223,7 @@ impl Settings {
             ambient: s.ambient.unwrap_or(false),
             lighting_only: s.lighting_only.unwrap_or(false),
             penumbra_visibility,
+            vertex_values,
             indirect_solver,
             uniform,
             penumbra_samples,
