@@ -125,6 +125,8 @@ pub struct UmbraCover<'a> {
     /// The one light that reaches the receiver, when only one does: its umbrae then cover
     /// the lines that belong to every light too.
     only_light: Option<u32>,
+    /// The covers' bounding boxes, and the grid that holds them.
+    boxes: Vec<(DVec2, DVec2)>,
     grid: BoxGrid,
     margin: f64,
 }
@@ -161,6 +163,7 @@ impl<'a> UmbraCover<'a> {
             covers,
             only_light,
             grid: BoxGrid::new(&boxes),
+            boxes,
             margin,
         }
     }
@@ -182,12 +185,20 @@ impl<'a> UmbraCover<'a> {
             return;
         }
         let light = light.or(self.only_light);
-        self.grid.meeting(a.min(b), a.max(b), scratch);
+        let (lo, hi) = (a.min(b), a.max(b));
+        self.grid.meeting(lo, hi, scratch);
         let mut cut: Vec<(f64, f64)> = Vec::new();
         let d = b - a;
         for &u in scratch.iter() {
             let (q, l, j) = self.covers[u as usize];
             if (l.is_some() && l != light) || (j.is_some() && j == own) {
+                continue;
+            }
+            // The grid's cells are coarse: most covers they give lie clear of the segment's
+            // box, and nothing of it is inside them (a sixth of room-8328's direct-only
+            // bake went to clipping against those).
+            let (clo, chi) = self.boxes[u as usize];
+            if clo.x > hi.x || clo.y > hi.y || chi.x < lo.x || chi.y < lo.y {
                 continue;
             }
             // Decided with the margin, cut where the segment crosses the boundary: the
