@@ -82,7 +82,8 @@ pub struct Stats {
     pub shadow_pairs_culled: u64,
     /// Refinement to `settings.tolerance` (mesh::refine): passes on the receiver that needed
     /// most, elements it added over the scene, and exact light evaluations it made (each
-    /// reused as vertex light where it became a vertex).
+    /// reused as vertex light where it became a vertex), the fit's of lit midpoints
+    /// (`mesh::fit`) included.
     pub refine_passes: u64,
     pub refine_elements_added: u64,
     pub refine_evaluations: u64,

@@ -72,7 +72,8 @@ pub struct RefineStats {
     /// Elements before the first pass and after the last.
     pub elements_before: u64,
     pub elements_after: u64,
-    /// Light evaluations (vertices, midpoints, centroids).
+    /// Light evaluations (vertices, midpoints, centroids; and the midpoints the fit of the
+    /// vertex values read, `fit`).
     pub evaluations: u64,
 }
 
