@@ -134,46 +134,35 @@ impl Settings {
                 format!("{convergence} must be in (0, 1)"),
             ));
         }
-        let uniform = match s.meshing.as_deref() {
-            None | Some("discontinuity") => false,
-            Some("uniform") => true,
-            Some(o) => {
-                return Err(BakeError::setting(
-                    "meshing",
-                    format!("{o:?} is not \"discontinuity\" or \"uniform\""),
-                ))
-            }
-        };
-        let penumbra_visibility = match s.penumbra_visibility.as_deref() {
-            None | Some("exact") => PenumbraVisibility::Exact,
-            Some("sampled") => PenumbraVisibility::Sampled,
-            Some(o) => {
-                return Err(BakeError::setting(
-                    "penumbra_visibility",
-                    format!("{o:?} is not \"exact\" or \"sampled\""),
-                ))
-            }
-        };
-        let vertex_values = match s.vertex_values.as_deref() {
-            None | Some("fitted") => VertexValues::Fitted,
-            Some("exact") => VertexValues::Exact,
-            Some(o) => {
-                return Err(BakeError::setting(
-                    "vertex_values",
-                    format!("{o:?} is not \"fitted\" or \"exact\""),
-                ))
-            }
-        };
-        let indirect_solver = match s.indirect_solver.as_deref() {
-            Some("progressive") => IndirectSolver::Progressive,
-            None | Some("hierarchical") => IndirectSolver::Hierarchical,
-            Some(o) => {
-                return Err(BakeError::setting(
-                    "indirect_solver",
-                    format!("{o:?} is not \"progressive\" or \"hierarchical\""),
-                ))
-            }
-        };
+        let uniform = one_of(
+            "meshing",
+            s.meshing.as_deref(),
+            &[("discontinuity", false), ("uniform", true)],
+        )?;
+        let penumbra_visibility = one_of(
+            "penumbra_visibility",
+            s.penumbra_visibility.as_deref(),
+            &[
+                ("exact", PenumbraVisibility::Exact),
+                ("sampled", PenumbraVisibility::Sampled),
+            ],
+        )?;
+        let vertex_values = one_of(
+            "vertex_values",
+            s.vertex_values.as_deref(),
+            &[
+                ("fitted", VertexValues::Fitted),
+                ("exact", VertexValues::Exact),
+            ],
+        )?;
+        let indirect_solver = one_of(
+            "indirect_solver",
+            s.indirect_solver.as_deref(),
+            &[
+                ("hierarchical", IndirectSolver::Hierarchical),
+                ("progressive", IndirectSolver::Progressive),
+            ],
+        )?;
         let penumbra_samples = s.penumbra_samples.unwrap_or(64);
         if !(1..=65536).contains(&penumbra_samples) {
             return Err(BakeError::setting(
@@ -231,6 +220,24 @@ impl Settings {
             threads: s.threads,
             world,
         })
+    }
+}
+
+/// The option named `value` among `options` (the first when none is given), or an error
+/// that lists them.
+fn one_of<T: Copy>(name: &str, value: Option<&str>, options: &[(&str, T)]) -> Result<T, BakeError> {
+    let Some(v) = value else {
+        return Ok(options[0].1);
+    };
+    match options.iter().find(|(o, _)| *o == v) {
+        Some(&(_, t)) => Ok(t),
+        None => {
+            let names: Vec<String> = options.iter().map(|(o, _)| format!("{o:?}")).collect();
+            Err(BakeError::setting(
+                name,
+                format!("{v:?} is not {}", names.join(" or ")),
+            ))
+        }
     }
 }
 
