@@ -11,7 +11,8 @@
 //!
 //! The light is handed in by the caller (`LightAt`), so the mesh stage does not reach into
 //! the direct stage; every value computed here is returned with the mesh and reused as the
-//! vertex's direct light.
+//! vertex's direct light, fitted over the elements around it unless `vertex_values` is
+//! "exact" (`fit`).
 
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicU64, Ordering};
