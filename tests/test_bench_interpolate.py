@@ -75,3 +75,30 @@ def test_probe_inside_a_box_behind_a_third_box_is_buried():
     px = np.array([[1.0, 0.4, 0.4], [1.0, 0.8, 0.8]])
     out = probes.buried(scene, np.array([0, 0]), np.array([side, side]), px)
     assert out.tolist() == [True, False]
+
+
+def test_jittered_probes_stay_in_their_polygons_and_no_triangle_folds():
+    # A pentagon (fan of three triangles) and the tilted triangle: the jitter moves every
+    # interior vertex, within its plane, and leaves the boundary where it was.
+    scene = _scene()
+    scene["meshes"].append({"name": "Penta", "positions": [
+        [0, 0, 3], [1, 0, 3], [1.4, 0.8, 3], [0.5, 1.4, 3], [-0.4, 0.8, 3]],
+        "polygons": [[0, 1, 2, 3, 4]]})
+    plain, (pm, pp, px) = probes.scene_probes(scene, 0.2)
+    moved, (qm, qp, qx) = probes.scene_probes(scene, 0.2, jitter=7)
+    again = probes.scene_probes(scene, 0.2, jitter=7)[1][2]
+    np.testing.assert_array_equal(qx, again)
+    assert (pm == qm).all() and (pp == qp).all()
+    shift = np.linalg.norm(qx - px, axis=1)
+    assert (shift > 1e-9).all() and shift.max() < 0.2
+    for a, b in zip(plain, moved):
+        np.testing.assert_array_equal(a["verts"][~a["probe"]], b["verts"][~b["probe"]])
+        V, T = b["verts"], b["tris"]
+        n0 = np.cross(a["verts"][T[:, 1]] - a["verts"][T[:, 0]],
+                      a["verts"][T[:, 2]] - a["verts"][T[:, 0]])
+        n1 = np.cross(V[T[:, 1]] - V[T[:, 0]], V[T[:, 2]] - V[T[:, 0]])
+        # Every triangle keeps its orientation: none folds.
+        assert (np.einsum("ij,ij->i", n0, n1) > 0).all()
+        # Still in the polygon's plane.
+        normal = n0.sum(0) / np.linalg.norm(n0.sum(0))
+        np.testing.assert_allclose((V - a["verts"]) @ normal, 0.0, atol=1e-12)

@@ -2,7 +2,7 @@
 
     python cycles_job.py bake  SCENE.json OUT.npz --spacing S --samples N --seed K
                                [--adaptive] [--direct-only] [--bounces B] [--threads T]
-                               [--mesh-spacing H]
+                               [--mesh-spacing H] [--jitter SEED]
     python cycles_job.py render SCENE.json OUT.png --samples N [--bake BAKE.json] ...
 
 Prints one JSON line: {"seconds": time of the bake (or render) call, "peak_rss_mb": ...}.
@@ -41,11 +41,13 @@ def main():
     ap.add_argument("--mesh-spacing", type=float,
                     help="bake a uniform mesh of this spacing and read the probes from it by "
                     "linear interpolation (a Cycles user's vertex-colour bake)")
+    ap.add_argument("--jitter", type=int,
+                    help="jitter the probes with this seed (probes.py)")
     a = ap.parse_args()
     scene = json.load(open(a.scene))
     blender.reset(a.samples, a.seed, a.adaptive, a.bounces, a.threads)
     if a.kind == "bake":
-        lat, (pm, pp, px) = probes.scene_probes(scene, a.spacing)
+        lat, (pm, pp, px) = probes.scene_probes(scene, a.spacing, a.jitter)
         mesh = probes.scene_probes(scene, a.mesh_spacing)[0] if a.mesh_spacing else lat
         objs = blender.cycles_scene(scene, mesh)
         passes = {"DIRECT", "COLOR"} if a.direct_only else {"DIRECT", "INDIRECT", "COLOR"}
