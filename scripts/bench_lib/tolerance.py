@@ -137,8 +137,13 @@ def markdown(res):
          f"`{res['command']}` on {m['nproc']} × {m['cpu']}, {m['ram_gb']} GB "
          f"(load {m['load_at_start']} at start; machine shared), commit {m['commit']}, "
          f"{m['date']}; {res['minutes']:.1f} min. `indirect: false`; errors against the "
-         f"Cycles direct-only reference at the probe lattice (method above; "
-         f"{res['scenes'][0].get('samples', '?')} samples per seed). Uniform: `meshing: uniform` "
+         f"Cycles direct-only reference (method above, {res['scenes'][0].get('samples', '?')} "
+         f"samples per seed) at probes {res.get('probe_density', 1)}× as dense as the suite's, "
+         f"each moved off the lattice by a random offset (seed {res.get('jitter')}; "
+         "`probes.py`: a lattice of round spacing on these round-number scenes can sit on a "
+         "shadow's edge or beside all of them). "
+         "Probes: " + ", ".join(f"{sc['name']} {sc['probes']:,}" for sc in res["scenes"])
+         + ". Uniform: `meshing: uniform` "
          "tuned to the same element count, with the exact light at its vertices (as a vertex "
          "bake samples it). Ratio = discontinuity rel. RMS / uniform rel. RMS. The "
          "discontinuity mesh's vertex values are fitted to the light over their elements "
@@ -197,7 +202,7 @@ def run(a, cfg, machine, cycles, log, matched_uniform, root):
     t0 = time.perf_counter()
     res = dict(machine=machine, command="scripts/bench --tolerance"
                + (" --quick" if a.quick else "") + (" --no-scaling" if a.no_scaling else ""),
-               scenes=[])
+               probe_density=PROBE_DENSITY, jitter=JITTER_SEED, scenes=[])
     for name in a.scenes:
         log(f"scene {name}")
         res["scenes"].append(scene_rows(name, a.exe, a.work, cfg, cycles, log, matched_uniform))
