@@ -154,14 +154,19 @@ pub fn seen_from(
     let k = k.max(1);
     // The points first, then the rays: finding a point misses cache (the area table's
     // search, the corners, the vertices), and apart from the traversals the processor
-    // overlaps those misses across points.
+    // overlaps those misses across points. In two rounds, all the searches and then all
+    // the corners, so that no point's search waits behind another's corners.
+    let mut draws = [Draw::default(); BATCH];
     let mut ends = [(DVec3::ZERO, DVec3::ZERO, DVec3::ZERO, DVec3::ZERO); BATCH];
     // The face that blocked the last blocked segment, tried first on the next.
     let mut hint = None;
     for first in (0..k).step_by(BATCH) {
         let last = (first + BATCH as u32).min(k);
-        for (i, e) in (first..last).zip(ends.iter_mut()) {
-            *e = segment_ends(vis, table, start, s, k, i, seed);
+        for (i, d) in (first..last).zip(draws.iter_mut()) {
+            *d = segment_draw(table, start, s, k, i, seed);
+        }
+        for (d, e) in draws[..(last - first) as usize].iter().zip(ends.iter_mut()) {
+            *e = segment_ends(vis, start, d);
         }
         for &(p, n, y, ny) in &ends[..(last - first) as usize] {
             let d = y - p;
@@ -191,44 +196,48 @@ pub fn seen_from(
 /// Segments whose ends `seen_from` finds before it casts them.
 const BATCH: usize = 16;
 
-/// The ends of `seen_from`'s `i`-th of `k` segments from `start` to `s` (stream `seed`):
-/// start point and normal, end point and normal.
-fn segment_ends(
-    vis: &Visibility,
-    table: &AreaTable,
-    start: Start,
-    s: &Node,
-    k: u32,
-    i: u32,
-    seed: u64,
-) -> (DVec3, DVec3, DVec3, DVec3) {
+/// Where `seen_from`'s `i`-th of `k` segments from `start` to `s` (stream `seed`) ends:
+/// per end, the leaf position, the fraction of its area and the triangle coordinate
+/// (`point_at`); the start's are unused from a point.
+#[derive(Clone, Copy, Default)]
+struct Draw {
+    end: (u32, f64, f64),
+    start: (u32, f64, f64),
+}
+
+fn segment_draw(table: &AreaTable, start: Start, s: &Node, k: u32, i: u32, seed: u64) -> Draw {
     let r = mix(seed ^ mix(i as u64 + 1));
-    let (y, ny) = point_of(vis, table, s, (i as f64 + unit(r)) / k as f64, unit(mix(r)));
-    let (p, n) = match start {
-        Start::Point(p, n, _) => (p, n),
+    let (pos, t) = table.at(s, (i as f64 + unit(r)) / k as f64);
+    let mut d = Draw {
+        end: (pos, t, unit(mix(r))),
+        start: (0, 0.0, 0.0),
+    };
+    if let Start::Node(rn) = start {
         // The start's strata in another order (7 is prime to the powers of two the
         // counts are), so that the pairs do not run side by side across the two nodes.
-        Start::Node(rn) => {
-            let j = (i as u64 * 7 + 3) % k as u64;
-            let q = mix(r ^ 0x5851_f42d_4c95_7f2d);
-            point_of(
-                vis,
-                table,
-                rn,
-                (j as f64 + unit(q)) / k as f64,
-                unit(mix(q)),
-            )
-        }
+        let j = (i as u64 * 7 + 3) % k as u64;
+        let q = mix(r ^ 0x5851_f42d_4c95_7f2d);
+        let (pos, t) = table.at(rn, (j as f64 + unit(q)) / k as f64);
+        d.start = (pos, t, unit(mix(q)));
+    }
+    d
+}
+
+/// The ends of the segment `d` draws: start point and normal, end point and normal.
+fn segment_ends(vis: &Visibility, start: Start, d: &Draw) -> (DVec3, DVec3, DVec3, DVec3) {
+    let (y, ny) = point_at(vis, d.end);
+    let (p, n) = match start {
+        Start::Point(p, n, _) => (p, n),
+        Start::Node(_) => point_at(vis, d.start),
     };
     (p, n, y, ny)
 }
 
-/// The point of node `n` at the fraction `u` of its area (`AreaTable`), the part of its
-/// triangle's share that `u` falls at and `v` its coordinates in the triangle, with its
-/// leaf's normal (a back leaf faces the other way from its triangle).
-fn point_of(vis: &Visibility, table: &AreaTable, n: &Node, u: f64, v: f64) -> (DVec3, DVec3) {
+/// The point of leaf position `pos` at the part `t` of its triangle's share of the area and
+/// `v` its coordinates in the triangle, through the area-preserving square-to-triangle map,
+/// with its leaf's normal (a back leaf faces the other way from its triangle).
+fn point_at(vis: &Visibility, (pos, t, v): (u32, f64, f64)) -> (DVec3, DVec3) {
     let h = vis.h;
-    let (pos, t) = table.at(n, u);
     let [a, b, c, leaf_face] = h.corners[pos as usize];
     let [a, b, c] = [a, b, c].map(|i| vis.el.positions[i as usize]);
     let st = t.sqrt();
