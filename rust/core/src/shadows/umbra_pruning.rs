@@ -380,15 +380,14 @@ mod test {
 
     #[test]
     fn deep_inside_agrees_with_the_clipper() {
+        use crate::geom::hash::{mix, unit};
         use crate::geom::polygon::clip_segment_convex;
         // Random convex polygons (points on a circle, counter-clockwise, one edge of zero
         // length) and random segments, with and without a margin.
-        let mut seed = 0x9e3779b97f4a7c15u64;
+        let mut draws = 0u64;
         let mut rnd = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
+            draws += 1;
+            unit(mix(draws))
         };
         let mut compared = [0usize; 2];
         for _ in 0..2000 {
