@@ -101,6 +101,9 @@ const VARY_POWER: f64 = 64.0;
 const SOURCE_VARY_POWER: f64 = 64.0;
 /// Pairs with fewer leaves than this (receiver × source) are refined on one thread.
 const SERIAL_BELOW: u64 = 1 << 12;
+/// Links a thread keeps before it adds them to the shared count (`Refiner::publish`), which
+/// the budget (`max_links`) is checked against: it may run over by this much per thread.
+const PUBLISH_EVERY: u64 = 1024;
 
 pub struct Refiner<'a> {
     pub vis: Visibility<'a>,
@@ -114,7 +117,6 @@ pub struct Refiner<'a> {
     pub max_links: u64,
     pub progress: &'a Progress,
     links: AtomicU64,
-    rays_cast: AtomicU64,
     /// Area pairs settled (linked or dropped), as `f64` bits: progress over the total.
     settled: AtomicU64,
     total: f64,
@@ -157,7 +159,6 @@ impl<'a> Refiner<'a> {
             max_links,
             progress,
             links: AtomicU64::new(0),
-            rays_cast: AtomicU64::new(0),
             settled: AtomicU64::new(0f64.to_bits()),
             total,
             stop: AtomicBool::new(false),
@@ -171,10 +172,11 @@ impl<'a> Refiner<'a> {
         if !self.vis.h.nodes.is_empty() {
             self.refine(0, 0, Given::default(), &mut out);
         }
+        self.publish(&mut out);
         Refined {
             links: out.links,
             dropped: out.dropped,
-            rays: self.rays_cast.load(Ordering::Relaxed),
+            rays: out.rays,
             over_budget: self.links.load(Ordering::Relaxed) > self.max_links,
         }
     }
@@ -183,20 +185,39 @@ impl<'a> Refiner<'a> {
         &self.vis.h.nodes[i as usize]
     }
 
-    fn settle(&self, r: &Node, s: &Node) {
-        let add = r.area * s.area;
-        let mut cur = self.settled.load(Ordering::Relaxed);
-        loop {
-            let next = (f64::from_bits(cur) + add).to_bits();
-            match self.settled.compare_exchange_weak(
-                cur,
-                next,
-                Ordering::Relaxed,
-                Ordering::Relaxed,
-            ) {
-                Ok(_) => break,
-                Err(c) => cur = c,
+    /// Counts a settled pair in `out`, which hands its counts on now and then (`publish`).
+    fn settle(&self, r: &Node, s: &Node, out: &mut Out) {
+        out.settled += r.area * s.area;
+    }
+
+    /// Hands `out`'s counts of settled area and links to the shared ones, and reports
+    /// progress. Shared counters touched at every pair made the two threads fight over
+    /// their cache line: `publish` runs once per `PUBLISH_EVERY` links of a thread.
+    fn publish(&self, out: &mut Out) {
+        if out.settled > 0.0 {
+            let add = std::mem::take(&mut out.settled);
+            let mut cur = self.settled.load(Ordering::Relaxed);
+            loop {
+                let next = (f64::from_bits(cur) + add).to_bits();
+                match self.settled.compare_exchange_weak(
+                    cur,
+                    next,
+                    Ordering::Relaxed,
+                    Ordering::Relaxed,
+                ) {
+                    Ok(_) => break,
+                    Err(c) => cur = c,
+                }
             }
+        }
+        let n = std::mem::take(&mut out.unpublished);
+        if n > 0 {
+            self.links.fetch_add(n, Ordering::Relaxed);
+        }
+        let done = f64::from_bits(self.settled.load(Ordering::Relaxed));
+        self.progress.set_fraction(done / self.total.max(1e-300));
+        if self.progress.is_cancelled() {
+            self.stop.store(true, Ordering::Relaxed);
         }
     }
 
@@ -207,7 +228,7 @@ impl<'a> Refiner<'a> {
         let (rn, sn) = (self.node(r), self.node(s));
         if r == s {
             if rn.is_leaf() || rn.is_planar() {
-                self.settle(rn, sn);
+                self.settle(rn, sn, out);
                 return;
             }
             let [a, b] = rn.kids;
@@ -216,7 +237,7 @@ impl<'a> Refiner<'a> {
         // A face's front and back (`back`) see nothing of each other either.
         let h = self.vis.h;
         if rn.is_planar() && h.real_face(rn.face) == h.real_face(sn.face) {
-            self.settle(rn, sn);
+            self.settle(rn, sn, out);
             return;
         }
         let mut ends = Ends::new(h, self.vis.faces, r, s);
@@ -238,7 +259,7 @@ impl<'a> Refiner<'a> {
             })
         };
         if behind(sn, rn, ends.nr) || behind(rn, sn, ends.ns) {
-            self.settle(rn, sn);
+            self.settle(rn, sn, out);
             return;
         }
         // Hidden whole by the face, or the solid, that hid a pair above it.
@@ -254,7 +275,7 @@ impl<'a> Refiner<'a> {
             if faint_split && !self.over_budget() {
                 return self.split_larger(r, s, given, out);
             }
-            self.settle(rn, sn);
+            self.settle(rn, sn, out);
             let link = ends.link(h, self.vis.el, r, s, v as f64, false, Factor::Centroid);
             return self.push(out, link, &ends);
         }
@@ -346,7 +367,7 @@ impl<'a> Refiner<'a> {
             (v, cast) = (open.unwrap_or(0.0), cast + more);
         }
         if cast > 0 {
-            self.rays_cast.fetch_add(cast as u64, Ordering::Relaxed);
+            out.rays += cast as u64;
         }
         // Partly hidden: the shadow varies over the receiver, and a mean over it would
         // light its dark part (the seat right above a leg). Split the receiver first.
@@ -385,9 +406,9 @@ impl<'a> Refiner<'a> {
         if v == 1.0 && cast > 0 && splits && !blockers.as_ref().is_some_and(|l| l.is_empty()) {
             let (open, more) = self.second_look(r, s, blockers.as_deref(), rays.max(CONFIRM_RAYS));
             v = open.unwrap_or(v);
-            self.rays_cast.fetch_add(more as u64, Ordering::Relaxed);
+            out.rays += more as u64;
         }
-        self.settle(rn, sn);
+        self.settle(rn, sn, out);
         if v == 0.0 {
             if cast > 0 && sn.is_planar() {
                 out.dropped += 1;
@@ -407,13 +428,9 @@ impl<'a> Refiner<'a> {
             return;
         }
         out.links.push(link);
-        let n = self.links.fetch_add(1, Ordering::Relaxed) + 1;
-        if n % 4096 == 0 {
-            let done = f64::from_bits(self.settled.load(Ordering::Relaxed));
-            self.progress.set_fraction(done / self.total.max(1e-300));
-            if self.progress.is_cancelled() {
-                self.stop.store(true, Ordering::Relaxed);
-            }
+        out.unpublished += 1;
+        if out.unpublished >= PUBLISH_EVERY {
+            self.publish(out);
         }
     }
 
@@ -438,7 +455,7 @@ impl<'a> Refiner<'a> {
 
     /// Settles a pair that nothing passes between.
     fn hidden(&self, rn: &Node, sn: &Node, out: &mut Out) {
-        self.settle(rn, sn);
+        self.settle(rn, sn, out);
         if sn.is_planar() {
             out.dropped += 1;
         }
@@ -492,6 +509,9 @@ impl<'a> Refiner<'a> {
         for part in [la, lb] {
             out.links.extend(part.links);
             out.dropped += part.dropped;
+            out.rays += part.rays;
+            out.settled += part.settled;
+            out.unpublished += part.unpublished;
         }
     }
 }
@@ -525,6 +545,10 @@ impl<'b> Given<'b> {
 pub struct Out {
     links: Vec<Link>,
     dropped: u64,
+    rays: u64,
+    /// Settled area and links not yet added to the shared counts (`Refiner::publish`).
+    settled: f64,
+    unpublished: u64,
 }
 
 /// Nodes that hold both leaves across a narrow gap and leaves that are not (a leaf lies in
