@@ -22,7 +22,7 @@
 use glam::DVec2;
 
 use crate::geom::box_grid::{bounds, BoxGrid};
-use crate::geom::polygon::{inside_convex, signed_area_2d};
+use crate::geom::polygon::{clip_segment_deep, convex_edges_into, inside_convex, signed_area_2d};
 use crate::shadows::polygons::{Exposure, ShadowPolygon};
 
 /// Removes from `polys` every polygon that lies inside another (kept) umbra polygon of the
@@ -128,10 +128,8 @@ pub struct UmbraCover<'a> {
     /// The covers' bounding boxes, and the grid that holds them.
     boxes: Vec<(DVec2, DVec2)>,
     grid: BoxGrid,
-    /// Each cover's edges (start, direction, length), `lines[spans[i]]`, the zero-length
-    /// left out: made once, as `uncovered` tests a segment against many covers (a sixth of
-    /// room-8328's direct-only bake went to that clipping, most of it to the edges'
-    /// lengths).
+    /// Each cover's edges (`convex_edges`), `lines[spans[i]]`: made once, as `uncovered`
+    /// tests a segment against many covers.
     lines: Vec<(DVec2, DVec2, f64)>,
     spans: Vec<(u32, u32)>,
     margin: f64,
@@ -169,12 +167,7 @@ impl<'a> UmbraCover<'a> {
         let mut spans = Vec::with_capacity(covers.len());
         for (q, _, _) in &covers {
             let start = lines.len() as u32;
-            for (i, &p) in q.iter().enumerate() {
-                let e = q[(i + 1) % q.len()] - p;
-                if e != DVec2::ZERO {
-                    lines.push((p, e, e.length()));
-                }
-            }
+            convex_edges_into(q, &mut lines);
             spans.push((start, lines.len() as u32));
         }
         UmbraCover {
@@ -226,7 +219,7 @@ impl<'a> UmbraCover<'a> {
             // instead of leaving stubs inside that would stay as dangling edges.
             let (s0, s1) = self.spans[u as usize];
             if let Some(deep) =
-                deep_inside(&self.lines[s0 as usize..s1 as usize], a, b, self.margin)
+                clip_segment_deep(&self.lines[s0 as usize..s1 as usize], a, b, self.margin)
             {
                 cut.push(deep);
                 if deep.0 <= 0.0 && deep.1 >= 1.0 {
@@ -252,57 +245,6 @@ impl<'a> UmbraCover<'a> {
             out.push((at(t), b));
         }
     }
-}
-
-/// The part of a–b inside the convex polygon whose edges are `lines` (as
-/// `UmbraCover::lines`), when some of it lies at least `margin` inside every edge line:
-/// `clip_segment_convex(a, b, poly, margin, 0)`, to the last bit, with both of its passes
-/// in one and each edge's length made once.
-fn deep_inside(
-    lines: &[(DVec2, DVec2, f64)],
-    a: DVec2,
-    b: DVec2,
-    margin: f64,
-) -> Option<(f64, f64)> {
-    let d = b - a;
-    let (mut t0, mut t1) = (0.0f64, 1.0f64);
-    let (mut s0, mut s1) = (0.0f64, 1.0f64);
-    let mut outside = false;
-    // As the clipper: line values in lengths only where a margin asks for them.
-    let euclidean = margin != 0.0;
-    for &(p, e, len) in lines {
-        let (f0, fd) = if euclidean {
-            (e.perp_dot(a - p) / len, e.perp_dot(d) / len)
-        } else {
-            (e.perp_dot(a - p), e.perp_dot(d))
-        };
-        let g0 = f0 - margin;
-        let (out_a, out_b) = (g0 < 0.0, g0 + fd < 0.0);
-        if out_a && out_b {
-            return None;
-        }
-        if out_a {
-            t0 = t0.max(-g0 / fd);
-        } else if out_b {
-            t1 = t1.min(-g0 / fd);
-        }
-        let (out_a, out_b) = (f0 < 0.0, f0 + fd < 0.0);
-        if out_a && out_b {
-            outside = true;
-        } else if out_a {
-            s0 = s0.max(-f0 / fd);
-        } else if out_b {
-            s1 = s1.min(-f0 / fd);
-        }
-    }
-    if t0 >= t1 {
-        return None;
-    }
-    Some(if outside || s0 >= s1 {
-        (t0, t1)
-    } else {
-        (s0, s1)
-    })
 }
 
 #[cfg(test)]
@@ -376,52 +318,5 @@ mod test {
             &mut out,
         );
         assert!(out.is_empty());
-    }
-
-    #[test]
-    fn deep_inside_agrees_with_the_clipper() {
-        use crate::geom::hash::{mix, unit};
-        use crate::geom::polygon::clip_segment_convex;
-        // Random convex polygons (points on a circle, counter-clockwise, one edge of zero
-        // length) and random segments, with and without a margin.
-        let mut draws = 0u64;
-        let mut rnd = || {
-            draws += 1;
-            unit(mix(draws))
-        };
-        let mut compared = [0usize; 2];
-        for _ in 0..2000 {
-            let n = 3 + (rnd() * 5.0) as usize;
-            let mut angles: Vec<f64> = (0..n).map(|_| rnd() * std::f64::consts::TAU).collect();
-            angles.sort_by(f64::total_cmp);
-            let mut poly: Vec<DVec2> = angles
-                .iter()
-                .map(|t| DVec2::new(t.cos(), t.sin()))
-                .collect();
-            poly.insert(1, poly[0]);
-            if signed_area_2d(&poly) <= 1e-3 {
-                continue;
-            }
-            let lines: Vec<(DVec2, DVec2, f64)> = (0..poly.len())
-                .filter_map(|i| {
-                    let e = poly[(i + 1) % poly.len()] - poly[i];
-                    (e != DVec2::ZERO).then(|| (poly[i], e, e.length()))
-                })
-                .collect();
-            let a = DVec2::new(rnd() * 3.0 - 1.5, rnd() * 3.0 - 1.5);
-            let b = DVec2::new(rnd() * 3.0 - 1.5, rnd() * 3.0 - 1.5);
-            let margin = if rnd() < 0.5 { 0.0 } else { 0.2 * rnd() };
-            let want = clip_segment_convex(a, b, &poly, margin, 0.0);
-            let got = deep_inside(&lines, a, b, margin);
-            match (want, got) {
-                (None, None) => compared[0] += 1,
-                (Some(w), Some(g)) => {
-                    assert_eq!(w, g);
-                    compared[1] += 1;
-                }
-                _ => panic!("{a} {b} {margin}: {want:?} against {got:?}"),
-            }
-        }
-        assert!(compared[0] > 300 && compared[1] > 300, "{compared:?}");
     }
 }
