@@ -17,27 +17,34 @@ pub(super) fn longest(pos: &[DVec3], tri: &[u32; 3]) -> usize {
 }
 
 /// `tri` cut at the midpoints `mid` gives of its edges, its longest edge first (which
-/// the closure has split whenever any is): 1, 2, 3 or 4 triangles, same orientation.
+/// the closure has split whenever any is): 1, 2, 3 or 4 triangles, same orientation, as
+/// the first `n` of the array and `n` (no allocation: every triangle of a pass goes
+/// through here).
 pub(super) fn bisect(
     pos: &[DVec3],
     tri: [u32; 3],
     mid: &impl Fn(u32, u32) -> Option<u32>,
-) -> Vec<[u32; 3]> {
+) -> ([[u32; 3]; 4], usize) {
+    let mut out = [tri; 4];
     let l = longest(pos, &tri);
     let (a, b, c) = (tri[l], tri[(l + 1) % 3], tri[(l + 2) % 3]);
     let Some(m) = mid(a, b) else {
-        return vec![tri];
+        return (out, 1);
     };
-    let mut out = Vec::with_capacity(4);
+    let mut n = 0;
+    let mut push = |t: [u32; 3]| {
+        out[n] = t;
+        n += 1;
+    };
     match mid(a, c) {
-        Some(mca) => out.extend([[a, m, mca], [m, c, mca]]),
-        None => out.push([a, m, c]),
+        Some(mca) => [[a, m, mca], [m, c, mca]].into_iter().for_each(&mut push),
+        None => push([a, m, c]),
     }
     match mid(b, c) {
-        Some(mbc) => out.extend([[m, b, mbc], [m, mbc, c]]),
-        None => out.push([m, b, c]),
+        Some(mbc) => [[m, b, mbc], [m, mbc, c]].into_iter().for_each(&mut push),
+        None => push([m, b, c]),
     }
-    out
+    (out, n)
 }
 
 #[cfg(test)]
@@ -66,7 +73,8 @@ mod test {
                 (1, 2) if with_bc => Some(5),
                 _ => None,
             };
-            let parts = bisect(&pos, [0, 1, 2], &mid);
+            let (parts, n) = bisect(&pos, [0, 1, 2], &mid);
+            let parts = &parts[..n];
             assert_eq!(parts.len(), 2 + with_ca as usize + with_bc as usize);
             let sum: f64 = parts.iter().map(area).sum();
             assert!((sum - whole).abs() < 1e-12, "{sum} vs {whole}");

@@ -22,14 +22,13 @@
 //! longest-edge bisections (Rivara), closed over neighbours so the mesh stays conforming and
 //! its angles bounded.
 
-use std::collections::HashMap;
-
 use glam::DVec3;
 use rayon::prelude::*;
 
 use super::bisect::{bisect, longest};
 use super::hierarchy::{Hierarchy, NONE};
 use super::vertices::{Gather, LeafLook, Point};
+use crate::geom::hash::{IdMap, IdSet};
 use crate::mesh::elements::Elements;
 use crate::progress::Progress;
 use crate::scene::{Face, Scene};
@@ -111,13 +110,13 @@ enum Judged {
 /// What the passes learn and keep: each edge's midpoint, and values at edge ends.
 #[derive(Default)]
 struct Known {
-    mids: HashMap<(u32, u32), Mid>,
+    mids: IdMap<(u32, u32), Mid>,
     /// Smooth values of vertices on a leaf (`Gather::smooth`).
-    ends: HashMap<(u32, u32), DVec3>,
+    ends: IdMap<(u32, u32), DVec3>,
     /// Values at vertices on a leaf by its look (`Gather::looked`).
-    seen_ends: HashMap<(u32, u32), DVec3>,
+    seen_ends: IdMap<(u32, u32), DVec3>,
     /// Whether the means cannot judge a leaf's centre (`Gather::partly_seen`).
-    partly: HashMap<u32, bool>,
+    partly: IdMap<u32, bool>,
 }
 
 /// Splits the elements of `el` where the indirect light `indirect` (per vertex, from
@@ -130,7 +129,7 @@ pub fn subdivide(
     faces: &[Face],
     el: &Elements,
     gather: &Gather,
-    looks: &HashMap<u32, LeafLook>,
+    looks: &IdMap<u32, LeafLook>,
     direct: &[DVec3],
     indirect: &[DVec3],
     tol: f64,
@@ -216,7 +215,7 @@ pub fn subdivide(
         }
         // Regions of the triangles on either side of each edge, from their origins, and a
         // leaf that holds one of them (the closure may reach triangles in no leaf).
-        let mut sides: HashMap<(u32, u32), (Vec<u32>, u32)> = HashMap::new();
+        let mut sides: IdMap<(u32, u32), (Vec<u32>, u32)> = IdMap::default();
         for &(k, _) in &todo {
             let (mut r, mut leaf) = (Vec::new(), NONE);
             for &t in adj.of(k) {
@@ -272,7 +271,7 @@ pub fn subdivide(
         partly.extend(found);
         let mut which = Vec::new();
         let mut points: Vec<Point> = Vec::new();
-        let mut asked: HashMap<(u32, u32), usize> = HashMap::new();
+        let mut asked: IdMap<(u32, u32), usize> = IdMap::default();
         let mut slots: Vec<[usize; 3]> = Vec::new();
         for (i, (&((a, b), t), &(eval, _))) in todo.iter().zip(&lit).enumerate() {
             let leaf = sides[&(a, b)].1;
@@ -416,35 +415,37 @@ pub fn subdivide(
     for _ in 0..MAX_PASSES {
         progress.check()?;
         let adj = EdgeTris::new(&out.triangles);
-        // Edges whose ends differ, on triangles of a leaf, long enough to split.
-        let mut cand: Vec<((u32, u32), u32)> = Vec::new();
-        for (t, tri) in out.triangles.iter().enumerate() {
-            let o = origin[t] as usize;
-            if tri_leaf[o] == NONE {
-                continue;
-            }
-            let min_len = MIN_EDGE * extent[el.tri_face[o] as usize];
-            for i in 0..3 {
-                let (a, b) = (tri[i], tri[(i + 1) % 3]);
-                let k = key(a, b);
-                if known.mids.contains_key(&k) {
-                    continue;
-                }
-                let (ua, ub) = (a as usize, b as usize);
-                if (out.positions[ua] - out.positions[ub]).length() < 2.0 * min_len {
-                    continue;
-                }
-                let d = (out.indirect[ua] - out.indirect[ub]).abs().element_sum();
-                let base = 0.5
-                    * (direct_at(&out, ua)
-                        + out.indirect[ua]
-                        + direct_at(&out, ub)
-                        + out.indirect[ub]);
-                if d > SCREEN * tol * (base.element_sum() + floor) {
-                    cand.push((k, t as u32));
-                }
-            }
-        }
+        // Edges whose ends differ, on triangles of a leaf, long enough to split (on all
+        // threads: a scan of every triangle's edges each pass, room-245's 0.1 s of one).
+        let out_ref = &out;
+        let known_ref = &known;
+        let mut cand: Vec<((u32, u32), u32)> = out
+            .triangles
+            .par_iter()
+            .enumerate()
+            .flat_map_iter(|(t, tri)| {
+                let o = origin[t] as usize;
+                let min_len = MIN_EDGE * extent[el.tri_face[o] as usize];
+                let on_leaf = tri_leaf[o] != NONE;
+                (0..3).filter_map(move |i| {
+                    let (a, b) = (tri[i], tri[(i + 1) % 3]);
+                    let k = key(a, b);
+                    if !on_leaf || known_ref.mids.contains_key(&k) {
+                        return None;
+                    }
+                    let (ua, ub) = (a as usize, b as usize);
+                    let pos = &out_ref.positions;
+                    if (pos[ua] - pos[ub]).length() < 2.0 * min_len {
+                        return None;
+                    }
+                    let ind = &out_ref.indirect;
+                    let d = (ind[ua] - ind[ub]).abs().element_sum();
+                    let base =
+                        0.5 * (direct_at(out_ref, ua) + ind[ua] + direct_at(out_ref, ub) + ind[ub]);
+                    (d > SCREEN * tol * (base.element_sum() + floor)).then_some((k, t as u32))
+                })
+            })
+            .collect();
         cand.par_sort_unstable();
         cand.dedup_by_key(|x| x.0);
         if cand.is_empty() {
@@ -471,7 +472,7 @@ pub fn subdivide(
         // Closure: a triangle with a split edge splits its longest edge too (Rivara), and
         // that may mark its neighbour's.
         // Only triangles beside the edges marked last can have new work.
-        let mut marked: std::collections::HashSet<(u32, u32)> = split.iter().copied().collect();
+        let mut marked: IdSet<(u32, u32)> = split.iter().copied().collect();
         let mut frontier = split.clone();
         loop {
             progress.check()?;
@@ -530,13 +531,17 @@ pub fn subdivide(
                 .map(|m| m.vertex)
                 .filter(|&v| v != NONE && marked.contains(&key(a, b)))
         };
+        // Each triangle's parts on all threads, then laid out in triangle order.
+        let parts: Vec<([[u32; 3]; 4], usize)> = out
+            .triangles
+            .par_iter()
+            .map(|tri| bisect(&out.positions, *tri, &vertex_of))
+            .collect();
         let mut tris = Vec::with_capacity(out.triangles.len() + 2 * split.len());
         let mut orig = Vec::with_capacity(tris.capacity());
-        for (t, tri) in out.triangles.iter().enumerate() {
-            for c in bisect(&out.positions, *tri, &vertex_of) {
-                tris.push(c);
-                orig.push(origin[t]);
-            }
+        for ((p, n), &o) in parts.iter().zip(&origin) {
+            tris.extend_from_slice(&p[..*n]);
+            orig.extend(std::iter::repeat_n(o, *n));
         }
         out.triangles = tris;
         origin = orig;

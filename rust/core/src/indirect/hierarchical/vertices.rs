@@ -28,7 +28,6 @@
 //! Cluster sources keep their links' means: a point that sees less of a cluster's far side
 //! sees more of its near side, and a fraction of the whole says nothing of which.
 
-use std::collections::HashMap;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::DVec3;
@@ -40,7 +39,7 @@ use super::link::{planar_gather, point_coefficient};
 use super::own_look::{by_error, own_visibility, spread};
 use super::solve::{Gathering, Radiosity, Solver};
 use super::visibility::Visibility;
-use crate::geom::hash::mix;
+use crate::geom::hash::{mix, IdMap};
 use crate::mesh::elements::Elements;
 use crate::scene::Face;
 
@@ -143,7 +142,7 @@ impl<'a> Gather<'a> {
     /// Indirect irradiance at every element vertex by a final gather over the links `g`;
     /// vertices on no leaf (under a cover) get 0. Also each gathered leaf's look, for
     /// points on it later (`looked`).
-    pub fn vertices(&self) -> (Vec<DVec3>, HashMap<u32, LeafLook>) {
+    pub fn vertices(&self) -> (Vec<DVec3>, IdMap<u32, LeafLook>) {
         let nv = self.el.positions.len();
         // The vertices of each leaf, in index order: they share the links above the leaf,
         // and the shafts from the leaf to those links' sources.
@@ -154,7 +153,7 @@ impl<'a> Gather<'a> {
             .map(|grp| self.leaf(grp[0].0, &self.chain(grp[0].0), grp))
             .collect();
         let mut out = vec![DVec3::ZERO; nv];
-        let mut looks = HashMap::with_capacity(groups.len());
+        let mut looks = IdMap::with_capacity_and_hasher(groups.len(), Default::default());
         for (grp, (vals, look)) in groups.iter().zip(per_leaf) {
             for (v, e) in vals {
                 out[v as usize] = e;
