@@ -354,7 +354,10 @@ impl Gather<'_> {
         chain: &[u32],
         verts: &[(u32, u32)],
     ) -> (Vec<(u32, DVec3)>, LeafLook) {
-        let unsure = self.look(leaf, chain, self.darkest(verts));
+        // Rays counted here and added to the shared count once per leaf: an atomic add per
+        // look made the two threads pass its cache line back and forth.
+        let mut rays = 0;
+        let unsure = self.look(leaf, chain, self.darkest(verts), &mut rays);
         let pos: Vec<DVec3> = verts
             .iter()
             .map(|&(_, v)| self.el.positions[v as usize])
@@ -363,10 +366,11 @@ impl Gather<'_> {
             let (out, own): (Vec<(u32, DVec3)>, Vec<Vec<f64>>) = verts
                 .iter()
                 .map(|&(_, v)| {
-                    let (e, own) = self.at(v, leaf, chain, &unsure);
+                    let (e, own) = self.at(v, leaf, chain, &unsure, &mut rays);
                     ((v, e), own)
                 })
                 .unzip();
+            self.rays.fetch_add(rays, Ordering::Relaxed);
             let look = LeafLook::keep(&unsure, pos.into_iter().zip(own));
             return (out, look);
         }
@@ -374,7 +378,7 @@ impl Gather<'_> {
         let mut out: Vec<(u32, DVec3)> = verts.iter().map(|&(_, v)| (v, DVec3::ZERO)).collect();
         let mut seen: Vec<Vec<f64>> = Vec::with_capacity(anchors.len());
         for &i in &anchors {
-            let (e, own) = self.at(verts[i].1, leaf, chain, &unsure);
+            let (e, own) = self.at(verts[i].1, leaf, chain, &unsure, &mut rays);
             out[i].1 = e;
             seen.push(own);
         }
@@ -387,6 +391,7 @@ impl Gather<'_> {
             inverse_square(pos[i], from, &mut own);
             out[i].1 = self.between(v, leaf, chain, &unsure, &own);
         }
+        self.rays.fetch_add(rays, Ordering::Relaxed);
         let look = LeafLook::keep(&unsure, anchors.iter().map(|&j| pos[j]).zip(seen));
         (out, look)
     }
@@ -414,7 +419,7 @@ impl Gather<'_> {
         unsure
     }
 
-    fn look(&self, leaf: u32, chain: &[u32], darkest: f64) -> Vec<Unsure> {
+    fn look(&self, leaf: u32, chain: &[u32], darkest: f64, cast: &mut u64) -> Vec<Unsure> {
         let (h, faces) = (self.h, self.faces);
         let ln = &h.nodes[leaf as usize];
         let n = faces[ln.face as usize].plane.n;
@@ -437,7 +442,7 @@ impl Gather<'_> {
                 let screened = (u.v == 1.0)
                     .then(|| seen_from(self.vis, &self.table, start, s, None, SCREEN_RAYS, seed));
                 if let Some(x) = screened {
-                    self.rays.fetch_add(x.rays as u64, Ordering::Relaxed);
+                    *cast += x.rays as u64;
                 }
                 if screened.is_some_and(|x| x.fraction().is_none_or(|f| f == u.v)) {
                     continue;
@@ -453,7 +458,7 @@ impl Gather<'_> {
                     seed,
                     screened,
                 );
-                self.rays.fetch_add(rays as u64, Ordering::Relaxed);
+                *cast += rays as u64;
                 (u.v, u.varies, u.blockers) = (v, varies, Some(list));
             }
         }
@@ -531,8 +536,16 @@ impl Gather<'_> {
 
     /// Irradiance at vertex `v` of `leaf` (ancestors `chain`), given the leaf's look at its
     /// `unsure` links: the vertex looks itself at those the leaf found in part. Also returns
-    /// the visibility it used for each of `unsure` (the link's where it did not look).
-    fn at(&self, v: u32, leaf: u32, chain: &[u32], unsure: &[Unsure]) -> (DVec3, Vec<f64>) {
+    /// the visibility it used for each of `unsure` (the link's where it did not look); the
+    /// rays it cast are added to `cast`.
+    fn at(
+        &self,
+        v: u32,
+        leaf: u32,
+        chain: &[u32],
+        unsure: &[Unsure],
+        cast: &mut u64,
+    ) -> (DVec3, Vec<f64>) {
         let seed = v as u64;
         self.at_point(
             self.place(v, leaf),
@@ -540,6 +553,7 @@ impl Gather<'_> {
             self.direct[v as usize],
             chain,
             unsure,
+            cast,
         )
     }
 
@@ -552,6 +566,7 @@ impl Gather<'_> {
         direct: DVec3,
         chain: &[u32],
         unsure: &[Unsure],
+        cast: &mut u64,
     ) -> (DVec3, Vec<f64>) {
         let h = self.h;
         let mut xs = Vec::with_capacity(unsure.len());
@@ -573,7 +588,7 @@ impl Gather<'_> {
             let start = Start::Point(p, n, face);
             let (own, _, rays) =
                 own_visibility(self.vis, &self.table, start, s, list, u.v, seed, None);
-            self.rays.fetch_add(rays as u64, Ordering::Relaxed);
+            *cast += rays as u64;
             e += xs[i] * (own - u.v);
             used[i] = own;
         }
