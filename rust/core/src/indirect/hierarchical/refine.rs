@@ -174,7 +174,7 @@ impl<'a> Refiner<'a> {
         }
         self.publish(&mut out);
         Refined {
-            links: out.links,
+            links: out.links.concat(),
             dropped: out.dropped,
             rays: out.rays,
             over_budget: self.links.load(Ordering::Relaxed) > self.max_links,
@@ -427,7 +427,10 @@ impl<'a> Refiner<'a> {
         if !(link.k > 0.0 || ends.factor_bound() > 0.0) {
             return;
         }
-        out.links.push(link);
+        match out.links.last_mut() {
+            Some(run) => run.push(link),
+            None => out.links.push(vec![link]),
+        }
         out.unpublished += 1;
         if out.unpublished >= PUBLISH_EVERY {
             self.publish(out);
@@ -543,7 +546,9 @@ impl<'b> Given<'b> {
 /// What a refinement (or one branch of it) made, in refinement order.
 #[derive(Default)]
 pub struct Out {
-    links: Vec<Link>,
+    /// In runs, in order: a branch's runs are moved to its parent's list, not copied into
+    /// its vector at every level of the recursion.
+    links: Vec<Vec<Link>>,
     dropped: u64,
     rays: u64,
     /// Settled area and links not yet added to the shared counts (`Refiner::publish`).
