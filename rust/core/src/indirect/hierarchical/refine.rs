@@ -174,7 +174,7 @@ impl<'a> Refiner<'a> {
         }
         self.publish(&mut out);
         Refined {
-            links: out.links.concat(),
+            links: join_runs(out.links),
             dropped: out.dropped,
             rays: out.rays,
             over_budget: self.links.load(Ordering::Relaxed) > self.max_links,
@@ -509,7 +509,11 @@ impl<'a> Refiner<'a> {
                 v
             },
         );
-        for part in [la, lb] {
+        for mut part in [la, lb] {
+            // A run grows by doubling; one that no longer grows gives back its slack.
+            if let Some(run) = part.links.last_mut() {
+                run.shrink_to_fit();
+            }
             out.links.extend(part.links);
             out.dropped += part.dropped;
             out.rays += part.rays;
@@ -517,6 +521,16 @@ impl<'a> Refiner<'a> {
             out.unpublished += part.unpublished;
         }
     }
+}
+
+/// The runs laid end to end, each freed once copied (a copy of all of them at once would
+/// hold every link twice).
+fn join_runs(runs: Vec<Vec<Link>>) -> Vec<Link> {
+    let mut all = Vec::with_capacity(runs.iter().map(Vec::len).sum());
+    for run in runs {
+        all.extend(run);
+    }
+    all
 }
 
 /// What a pair is handed from the pair it was split from.

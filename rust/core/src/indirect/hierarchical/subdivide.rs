@@ -52,6 +52,8 @@ const MIN_EDGE: f64 = 1.0 / 512.0;
 const LOOK_SCALE: f64 = 2.0;
 /// Vertices the splits may add, per vertex of the mesh (a bound on memory and time).
 const MAX_ADDED_PER_VERTEX: usize = 1;
+/// Triangles per chunk of the rebuild after a pass's bisections.
+const BISECT_CHUNK: usize = 4096;
 /// The floor under the local light against which an error is judged: this share of the
 /// mean light over the vertices (so that nearly black corners do not split forever).
 const FLOOR: f64 = 0.05;
@@ -531,18 +533,38 @@ pub fn subdivide(
                 .map(|m| m.vertex)
                 .filter(|&v| v != NONE && marked.contains(&key(a, b)))
         };
-        // Each triangle's parts on all threads, then laid out in triangle order.
-        let parts: Vec<([[u32; 3]; 4], usize)> = out
+        // On all threads, in chunks of triangles: each chunk's parts counted, then written
+        // where the counts before it put them (no copy of the whole list in between).
+        let bisect_of = |tri: &[u32; 3]| bisect(&out.positions, *tri, &vertex_of);
+        let counts: Vec<usize> = out
             .triangles
-            .par_iter()
-            .map(|tri| bisect(&out.positions, *tri, &vertex_of))
+            .par_chunks(BISECT_CHUNK)
+            .map(|c| c.iter().map(|t| bisect_of(t).1).sum())
             .collect();
-        let mut tris = Vec::with_capacity(out.triangles.len() + 2 * split.len());
-        let mut orig = Vec::with_capacity(tris.capacity());
-        for ((p, n), &o) in parts.iter().zip(&origin) {
-            tris.extend_from_slice(&p[..*n]);
-            orig.extend(std::iter::repeat_n(o, *n));
+        let total: usize = counts.iter().sum();
+        let mut tris = vec![[0u32; 3]; total];
+        let mut orig = vec![0u32; total];
+        let mut slots = Vec::with_capacity(counts.len());
+        let (mut rest_t, mut rest_o) = (&mut tris[..], &mut orig[..]);
+        for &n in &counts {
+            let (t, rt) = std::mem::take(&mut rest_t).split_at_mut(n);
+            let (o, ro) = std::mem::take(&mut rest_o).split_at_mut(n);
+            slots.push((t, o));
+            (rest_t, rest_o) = (rt, ro);
         }
+        slots
+            .into_par_iter()
+            .zip(out.triangles.par_chunks(BISECT_CHUNK))
+            .zip(origin.par_chunks(BISECT_CHUNK))
+            .for_each(|(((t, o), tri), from)| {
+                let mut k = 0;
+                for (tri, &from) in tri.iter().zip(from) {
+                    let (parts, n) = bisect_of(tri);
+                    t[k..k + n].copy_from_slice(&parts[..n]);
+                    o[k..k + n].fill(from);
+                    k += n;
+                }
+            });
         out.triangles = tris;
         origin = orig;
         // Split edges are gone from the mesh: their midpoints are vertices now.
