@@ -14,10 +14,12 @@ pub fn unit(h: u64) -> f64 {
     (h >> 11) as f64 / (1u64 << 53) as f64
 }
 
-/// A hasher for maps keyed by vertex and node ids, which the bake builds and queries by
-/// the hundred thousand (`subdivide`'s edges and midpoints): the standard library's keyed
-/// SipHash costs several times as much per small key, and guards against adversarial keys
-/// that ids cannot be. Its iteration order is also the same from run to run.
+/// A hasher for the maps the bake builds and queries by the hundred thousand, keyed by ids
+/// (`subdivide`'s edges and midpoints) or by the bits of coordinates (the light cache of
+/// `mesh::refine`): the standard library's keyed SipHash costs several times as much per
+/// small key (it was a sixth of a direct-only bake of data1, `perf`) and guards against
+/// adversarial keys that ids and coordinates cannot be. Its iteration order is also the same
+/// from run to run.
 #[derive(Clone, Copy, Default)]
 pub struct IdHasher(u64);
 
@@ -35,7 +37,13 @@ impl std::hash::Hasher for IdHasher {
     }
 
     fn write_u64(&mut self, x: u64) {
+        // One multiply-rotate step per word (as rustc's FxHasher), and `mix` at the end, so
+        // that the low bits a table's bucket takes depend on every bit of the key.
         self.0 = (self.0.rotate_left(29) ^ x).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    }
+
+    fn write_i64(&mut self, x: i64) {
+        self.write_u64(x as u64);
     }
 
     fn write_usize(&mut self, x: usize) {

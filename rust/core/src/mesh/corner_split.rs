@@ -4,14 +4,11 @@
 //! gets its own copy of the corner vertex, evaluated a hair inside that triangle, so that
 //! each carries the limit of the light from its own side, as the D0 rows do along a line.
 
-use std::collections::HashMap;
-use std::hash::BuildHasherDefault;
-
 use glam::DVec2;
 
-use super::refine::KeyHasher;
 use super::sides::nudge;
 use super::ReceiverMesh;
+use crate::geom::hash::IdMap;
 use crate::scene::Tolerances;
 
 /// Gives every triangle at a D0 line end (of `d0_lines`, or where the D0 rows of the split
@@ -30,8 +27,7 @@ pub(crate) fn split(m: &mut ReceiverMesh, d0_lines: &[[DVec2; 2]], tol: &Toleran
     let near = 1e-9 * scale;
     let cell = 1e-6 * scale;
     let at = |p: DVec2| ((p.x / cell).floor() as i64, (p.y / cell).floor() as i64);
-    let mut ends: HashMap<(i64, i64), Vec<DVec2>, BuildHasherDefault<KeyHasher>> =
-        HashMap::default();
+    let mut ends: IdMap<(i64, i64), Vec<DVec2>> = IdMap::default();
     // Only where the split found D0 rows that end or turn: a contact line along the
     // receiver's boundary (walls standing on a floor) parts nothing inside it, and its ends
     // there (the floor's corners) take one value, read at the vertex itself

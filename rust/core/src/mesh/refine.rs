@@ -14,7 +14,6 @@
 //! vertex's direct light, fitted over the elements around it unless `vertex_values` is
 //! "exact" (`fit`).
 
-use std::collections::HashMap;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::{DVec2, DVec3};
@@ -26,6 +25,7 @@ use super::extract::{components, extract_with, face_index, scale, Components};
 use super::readings::{Kind, View};
 use super::sides::{D0Test, Face};
 use super::{corner_split, fit, split, Cdt, Label, ReceiverMesh};
+use crate::geom::hash::IdMap;
 use crate::geom::Frame;
 use crate::regions::{ReceiverRegions, Region};
 use crate::scene::settings::{Settings, VertexValues};
@@ -109,37 +109,6 @@ pub(super) fn key(p: DVec2) -> [u64; 2] {
     [p.x.to_bits(), p.y.to_bits()]
 }
 
-/// A hasher for the light cache's keys (bits of two coordinates): the standard SipHash was a
-/// sixth of a direct-only bake of data1 (`perf`), for keys no adversary chooses.
-#[derive(Default, Clone, Copy)]
-pub(crate) struct KeyHasher(u64);
-
-impl std::hash::Hasher for KeyHasher {
-    fn finish(&self) -> u64 {
-        self.0
-    }
-    fn write(&mut self, bytes: &[u8]) {
-        for chunk in bytes.chunks(8) {
-            let mut word = [0u8; 8];
-            word[..chunk.len()].copy_from_slice(chunk);
-            self.write_u64(u64::from_le_bytes(word));
-        }
-    }
-    fn write_u64(&mut self, x: u64) {
-        // One multiply-rotate step per word (as rustc's FxHasher).
-        self.0 = (self.0.rotate_left(5) ^ x).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
-    }
-    fn write_usize(&mut self, x: usize) {
-        self.write_u64(x as u64);
-    }
-    fn write_i64(&mut self, x: i64) {
-        self.write_u64(x as u64);
-    }
-    fn write_u32(&mut self, x: u32) {
-        self.write_u64(x as u64);
-    }
-}
-
 /// A light value with its light counts, as `LightAt` gives them.
 pub(super) type Light = (DVec3, [u64; 3]);
 
@@ -149,7 +118,7 @@ pub(super) type Light = (DVec3, [u64; 3]);
 /// a seventh of its meshing (`perf`, call graphs); entries of 24 bytes move a third of that.
 #[derive(Default)]
 pub(super) struct Cache {
-    index: HashMap<[u64; 2], u32, std::hash::BuildHasherDefault<KeyHasher>>,
+    index: IdMap<[u64; 2], u32>,
     values: Vec<Light>,
 }
 
