@@ -46,6 +46,23 @@ pub(super) fn spread(points: &[DVec3], k: usize) -> Vec<usize> {
     chosen
 }
 
+/// The anchors' visibilities `from` (position, one per link) interpolated to `at` by
+/// inverse square distance, into `own`.
+pub(super) fn inverse_square<'x>(
+    at: DVec3,
+    from: impl Iterator<Item = (DVec3, &'x [f64])>,
+    own: &mut [f64],
+) {
+    own.fill(0.0);
+    let mut total = 0.0;
+    for (p, f) in from {
+        let w = 1.0 / ((at - p).length_squared() + 1e-30);
+        total += w;
+        own.iter_mut().zip(f).for_each(|(x, y)| *x += w * y);
+    }
+    own.iter_mut().for_each(|x| *x /= total);
+}
+
 /// Indices of `errs` from the largest down, as far as it takes for what is left to be
 /// under `allowed` (a stable sort: the same order on every thread).
 pub(super) fn by_error(errs: &[f64], allowed: f64) -> Vec<usize> {

@@ -25,7 +25,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::bisect::{bisect, longest};
+use super::bisect::{bisect_all, longest, EdgeTris};
 use super::hierarchy::{Hierarchy, NONE};
 use super::vertices::{Gather, LeafLook, Point};
 use crate::geom::hash::{IdMap, IdSet};
@@ -52,8 +52,6 @@ const MIN_EDGE: f64 = 1.0 / 512.0;
 const LOOK_SCALE: f64 = 2.0;
 /// Vertices the splits may add, per vertex of the mesh (a bound on memory and time).
 const MAX_ADDED_PER_VERTEX: usize = 1;
-/// Triangles per chunk of the rebuild after a pass's bisections.
-const BISECT_CHUNK: usize = 4096;
 /// The floor under the local light against which an error is judged: this share of the
 /// mean light over the vertices (so that nearly black corners do not split forever).
 const FLOOR: f64 = 0.05;
@@ -533,38 +531,7 @@ pub fn subdivide(
                 .map(|m| m.vertex)
                 .filter(|&v| v != NONE && marked.contains(&key(a, b)))
         };
-        // On all threads, in chunks of triangles: each chunk's parts counted, then written
-        // where the counts before it put them (no copy of the whole list in between).
-        let bisect_of = |tri: &[u32; 3]| bisect(&out.positions, *tri, &vertex_of);
-        let counts: Vec<usize> = out
-            .triangles
-            .par_chunks(BISECT_CHUNK)
-            .map(|c| c.iter().map(|t| bisect_of(t).1).sum())
-            .collect();
-        let total: usize = counts.iter().sum();
-        let mut tris = vec![[0u32; 3]; total];
-        let mut orig = vec![0u32; total];
-        let mut slots = Vec::with_capacity(counts.len());
-        let (mut rest_t, mut rest_o) = (&mut tris[..], &mut orig[..]);
-        for &n in &counts {
-            let (t, rt) = std::mem::take(&mut rest_t).split_at_mut(n);
-            let (o, ro) = std::mem::take(&mut rest_o).split_at_mut(n);
-            slots.push((t, o));
-            (rest_t, rest_o) = (rt, ro);
-        }
-        slots
-            .into_par_iter()
-            .zip(out.triangles.par_chunks(BISECT_CHUNK))
-            .zip(origin.par_chunks(BISECT_CHUNK))
-            .for_each(|(((t, o), tri), from)| {
-                let mut k = 0;
-                for (tri, &from) in tri.iter().zip(from) {
-                    let (parts, n) = bisect_of(tri);
-                    t[k..k + n].copy_from_slice(&parts[..n]);
-                    o[k..k + n].fill(from);
-                    k += n;
-                }
-            });
+        let (tris, orig) = bisect_all(&out.positions, &out.triangles, &origin, &vertex_of);
         out.triangles = tris;
         origin = orig;
         // Split edges are gone from the mesh: their midpoints are vertices now.
@@ -597,35 +564,5 @@ fn either<T: Copy>(old: &[T], added: &[T], nv: usize, v: usize) -> T {
         old[v]
     } else {
         added[v - nv]
-    }
-}
-
-/// The triangles around each edge of a mesh, by the edge's ends (smaller first): flat and
-/// sorted, as a map of small lists cost room-828 about 100 MB.
-struct EdgeTris {
-    keys: Vec<(u32, u32)>,
-    tris: Vec<u32>,
-}
-
-impl EdgeTris {
-    fn new(triangles: &[[u32; 3]]) -> Self {
-        let mut all: Vec<((u32, u32), u32)> = Vec::with_capacity(triangles.len() * 3);
-        for (t, tri) in triangles.iter().enumerate() {
-            for i in 0..3 {
-                let (a, b) = (tri[i], tri[(i + 1) % 3]);
-                all.push(((a.min(b), a.max(b)), t as u32));
-            }
-        }
-        // By edge, then by triangle: the order a map filled triangle by triangle gave.
-        all.par_sort_unstable();
-        let (keys, tris) = all.into_iter().unzip();
-        EdgeTris { keys, tris }
-    }
-
-    /// The triangles around the edge `k`, in index order (none if it is no edge).
-    fn of(&self, k: (u32, u32)) -> &[u32] {
-        let lo = self.keys.partition_point(|x| *x < k);
-        let hi = lo + self.keys[lo..].partition_point(|x| *x == k);
-        &self.tris[lo..hi]
     }
 }

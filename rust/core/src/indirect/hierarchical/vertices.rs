@@ -36,7 +36,7 @@ use rayon::prelude::*;
 use super::from_point::{seen_from, AreaTable, Start};
 use super::hierarchy::{Hierarchy, NONE};
 use super::link::{planar_gather, point_coefficient};
-use super::own_look::{by_error, own_visibility, spread};
+use super::own_look::{by_error, inverse_square, own_visibility, spread};
 use super::solve::{Gathering, Radiosity, Solver};
 use super::visibility::Visibility;
 use crate::geom::hash::{mix, IdMap};
@@ -594,17 +594,4 @@ impl Gather<'_> {
         }
         (e, used)
     }
-}
-
-/// The anchors' visibilities `from` (position, one per link) interpolated to `at` by
-/// inverse square distance, into `own`.
-fn inverse_square<'x>(at: DVec3, from: impl Iterator<Item = (DVec3, &'x [f64])>, own: &mut [f64]) {
-    own.fill(0.0);
-    let mut total = 0.0;
-    for (p, f) in from {
-        let w = 1.0 / ((at - p).length_squared() + 1e-30);
-        total += w;
-        own.iter_mut().zip(f).for_each(|(x, y)| *x += w * y);
-    }
-    own.iter_mut().for_each(|x| *x /= total);
 }
