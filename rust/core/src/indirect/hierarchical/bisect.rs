@@ -53,44 +53,34 @@ pub(super) fn bisect(
 const CHUNK: usize = 4096;
 
 /// Every triangle of `triangles` cut by `bisect` at the midpoints `mid` gives, in order,
-/// with the `origin` of each part (its triangle's). On all threads, in chunks: each chunk's
-/// parts counted, then written where the counts before it put them, with no copy of the
-/// whole list in between (a pass over room-245's 600k triangles took 0.04-0.07 s of one
-/// thread, and a list of every triangle's four slots 35 MB).
+/// with the `origin` of each part (its triangle's). On all threads, each chunk of triangles
+/// into its own lists, then laid end to end (a pass over room-245's 600k triangles took
+/// 0.04-0.07 s of one thread; a list of every triangle's four slots would hold 35 MB).
 pub(super) fn bisect_all(
     pos: &[DVec3],
     triangles: &[[u32; 3]],
     origin: &[u32],
     mid: &(impl Fn(u32, u32) -> Option<u32> + Sync),
 ) -> (Vec<[u32; 3]>, Vec<u32>) {
-    let counts: Vec<usize> = triangles
+    let chunks: Vec<(Vec<[u32; 3]>, Vec<u32>)> = triangles
         .par_chunks(CHUNK)
-        .map(|c| c.iter().map(|t| bisect(pos, *t, mid).1).sum())
-        .collect();
-    let total: usize = counts.iter().sum();
-    let mut tris = vec![[0u32; 3]; total];
-    let mut orig = vec![0u32; total];
-    let mut slots = Vec::with_capacity(counts.len());
-    let (mut rest_t, mut rest_o) = (&mut tris[..], &mut orig[..]);
-    for &n in &counts {
-        let (t, rt) = std::mem::take(&mut rest_t).split_at_mut(n);
-        let (o, ro) = std::mem::take(&mut rest_o).split_at_mut(n);
-        slots.push((t, o));
-        (rest_t, rest_o) = (rt, ro);
-    }
-    slots
-        .into_par_iter()
-        .zip(triangles.par_chunks(CHUNK))
         .zip(origin.par_chunks(CHUNK))
-        .for_each(|(((t, o), tri), from)| {
-            let mut k = 0;
+        .map(|(tri, from)| {
+            let (mut t, mut o) = (Vec::with_capacity(2 * tri.len()), Vec::new());
             for (tri, &from) in tri.iter().zip(from) {
                 let (parts, n) = bisect(pos, *tri, mid);
-                t[k..k + n].copy_from_slice(&parts[..n]);
-                o[k..k + n].fill(from);
-                k += n;
+                t.extend_from_slice(&parts[..n]);
+                o.extend(std::iter::repeat_n(from, n));
             }
-        });
+            (t, o)
+        })
+        .collect();
+    let total = chunks.iter().map(|(t, _)| t.len()).sum();
+    let (mut tris, mut orig) = (Vec::with_capacity(total), Vec::with_capacity(total));
+    for (t, o) in chunks {
+        tris.extend(t);
+        orig.extend(o);
+    }
     (tris, orig)
 }
 
