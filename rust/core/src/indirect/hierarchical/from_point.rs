@@ -85,13 +85,15 @@ impl AreaTable {
 }
 
 /// Sums of a run of rays from a point to a node: kernel over the open segments and over
-/// all, the sum of squared kernels (for the effective count) and the rays cast.
+/// all, the sum of squared kernels (for the effective count) and the rays cast; and the
+/// face that blocked the last blocked segment.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Seen {
     pub open: f64,
     pub total: f64,
     pub total_sq: f64,
     pub rays: u32,
+    pub blocker: Option<u32>,
 }
 
 impl Seen {
@@ -115,6 +117,7 @@ impl Seen {
         self.total += o.total;
         self.total_sq += o.total_sq;
         self.rays += o.rays;
+        self.blocker = o.blocker.or(self.blocker);
     }
 }
 
@@ -190,6 +193,7 @@ pub fn seen_from(
             }
         }
     }
+    out.blocker = hint;
     out
 }
 

@@ -96,7 +96,9 @@ pub(super) fn by_error(errs: &[f64], allowed: f64) -> Vec<usize> {
 /// stratification only lowers it), and `v·(1 − v) / m` when the vertex sees what it
 /// found. The larger of the two sets `z = |v − lv| / σ`. Under `NOISE` the mean is kept;
 /// from `SURE` on the vertex's own value is; in doubt between, the vertex casts
-/// `REPLACE_RAYS` more (up to `MAX_VERTEX_RAYS`), then blends the two smoothly.
+/// `REPLACE_RAYS` more (up to `MAX_VERTEX_RAYS`), then blends the two smoothly. Where the
+/// first round's rays are all blocked by a face that hides the whole source from the start
+/// (`Visibility::covers`), the visibility is 0, whatever the mean.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn own_visibility(
     vis: &Visibility,
@@ -137,6 +139,22 @@ pub(super) fn own_visibility(
         rays += more.rays;
         seen.add(more);
         cast += k;
+        // Every ray blocked: if the face that blocked them (or its solid) hides all of the
+        // source from all of the start, it sees none of it, and no more rays can say
+        // otherwise. The noise test alone kept a small mean there (0.2 after 16 blocked
+        // rays), and cast up to 64 rays for a larger one: room-245's final gather cast
+        // 23.2M rays before, 20.7M with this.
+        if round == 1 && seen.open == 0.0 && seen.rays > 0 {
+            if let Some(f) = seen.blocker {
+                let covered = match start {
+                    Start::Node(r) => vis.covers(f, r, s),
+                    Start::Point(p, n, _) => vis.covers_from(f, &[p], Some(n), s),
+                };
+                if covered {
+                    return (0.0, false, rays);
+                }
+            }
+        }
         let Some(v) = seen.fraction() else {
             return (lv, false, rays);
         };
@@ -161,6 +179,84 @@ pub(super) fn own_visibility(
 #[cfg(test)]
 mod test {
     use super::*;
+    use crate::geom::raycast::Occluders;
+    use crate::indirect::hierarchical::hierarchy::Hierarchy;
+    use crate::indirect::patches::test::grid_elements;
+    use crate::scene::test::face;
+
+    #[test]
+    fn a_look_that_a_face_hides_wholly_is_dark_after_one_round() {
+        // Floor facing up, ceiling facing down, and a blocker between them over x < 0. A
+        // link's mean of 0.2 (its receiver reaching past the blocker's edge) and a leaf
+        // wholly under the blocker: its 16 rays are all blocked, which under the noise test
+        // alone (z = √(16 · 0.2 / 0.8) = 2 at most) would keep the mean; the blocker covers
+        // the pair, so the leaf sees nothing, and casts no second round.
+        let square = |z: f64, up: bool| {
+            let v = |x, y| DVec3::new(x, y, z);
+            let mut p = vec![v(-1.0, -1.0), v(1.0, -1.0), v(1.0, 1.0), v(-1.0, 1.0)];
+            if !up {
+                p.reverse();
+            }
+            face(&p, DVec3::ONE, DVec3::ZERO)
+        };
+        let v = |x, y| DVec3::new(x, y, 0.5);
+        let half = face(
+            &[v(-3.0, -3.0), v(0.0, -3.0), v(0.0, 3.0), v(-3.0, 3.0)],
+            DVec3::ONE,
+            DVec3::ZERO,
+        );
+        let faces = vec![square(0.0, true), square(1.0, false), half];
+        let el = grid_elements(&faces[..2], 4);
+        let occ = Occluders::new(&faces);
+        let mut h = Hierarchy::build(&faces, &el, |_| true, 0.0);
+        h.set_boxes(&faces, &el);
+        let vis = Visibility {
+            h: &h,
+            faces: &faces,
+            el: &el,
+            occ: &occ,
+            solid_of: &[],
+            occluders: &[],
+        };
+        let table = AreaTable::new(&h);
+        let leaf_at = |face: u32, x: f64| {
+            h.nodes
+                .iter()
+                .find(|n| n.is_leaf() && n.face == face && n.hi_box.x < x)
+                .unwrap()
+        };
+        let (under, over) = (leaf_at(0, -0.2), leaf_at(1, -0.2));
+        let list = vis.blockers(under, over);
+        assert_eq!(list.as_deref(), Some(&[2][..]));
+        let look = |start| own_visibility(&vis, &table, start, over, list.as_deref(), 0.2, 7, None);
+        assert_eq!(look(Start::Node(under)), (0.0, false, REPLACE_RAYS));
+        // From a point under the blocker too.
+        let p = under.centroid;
+        assert_eq!(
+            look(Start::Point(p, DVec3::Z, 0)),
+            (0.0, false, REPLACE_RAYS)
+        );
+        // A pair the blocker hides in part: its rays find it, and the look goes on.
+        let ceiling = &h.nodes[h.nodes[0]
+            .kids
+            .into_iter()
+            .find(|&k| h.nodes[k as usize].face == 1)
+            .unwrap() as usize];
+        let (v, varies, rays) = own_visibility(
+            &vis,
+            &table,
+            Start::Node(under),
+            ceiling,
+            list.as_deref(),
+            0.2,
+            7,
+            None,
+        );
+        assert!(
+            varies && v > 0.0 && rays >= REPLACE_RAYS,
+            "{v} {varies} {rays}"
+        );
+    }
 
     #[test]
     fn anchors_spread_to_the_far_corners_first() {

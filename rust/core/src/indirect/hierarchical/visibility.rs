@@ -121,24 +121,16 @@ impl Visibility<'_> {
     /// `r` and `s` (judged by the triangles of a node of a few or the box of a larger one):
     /// then no ray need be cast.
     pub fn covers(&self, id: u32, r: &Node, s: &Node) -> bool {
-        // Up to two triangles' corners, or a box's: on the stack, as this runs for every
-        // pair under one that a face hid in part.
-        let pts = |n: &Node| -> ([DVec3; 8], usize) {
-            if n.hi - n.lo <= 2 {
-                let mut out = [DVec3::ZERO; 8];
-                for (k, i) in (n.lo..n.hi).enumerate() {
-                    let [a, b, c, _] = self.h.corners[i as usize];
-                    for (j, v) in [a, b, c].into_iter().enumerate() {
-                        out[3 * k + j] = self.el.positions[v as usize];
-                    }
-                }
-                (out, 3 * (n.hi - n.lo) as usize)
-            } else {
-                (corners(n), 8)
-            }
-        };
-        let ((pa, na), (pb, nb)) = (pts(r), pts(s));
-        let (a, b) = (&pa[..na], &pb[..nb]);
+        let (pa, na) = self.hull(r);
+        let nr = r.is_planar().then(|| self.faces[r.face as usize].plane.n);
+        self.covers_from(id, &pa[..na], nr, s)
+    }
+
+    /// `covers` from the points `a` (a node's corners, or one point) facing `na` where they
+    /// lie in a plane.
+    pub fn covers_from(&self, id: u32, a: &[DVec3], na: Option<DVec3>, s: &Node) -> bool {
+        let (pb, nb) = self.hull(s);
+        let b = &pb[..nb];
         if self.occ.face_covers(id, a, b) {
             return true;
         }
@@ -148,18 +140,37 @@ impl Visibility<'_> {
             .and_then(|&o| self.occluders.get(o as usize))
         {
             Some(Occluder::Solid { solid, .. }) => {
-                // The planar nodes' normals, turned from `r` towards `s`.
+                // The planar ends' normals, turned from `a` towards `s`.
                 let mut normals = [DVec3::ZERO; 2];
                 let mut k = 0;
-                for (n, sign) in [(r, 1.0), (s, -1.0)] {
-                    if n.is_planar() {
-                        normals[k] = self.faces[n.face as usize].plane.n * sign;
-                        k += 1;
-                    }
+                if let Some(n) = na {
+                    normals[k] = n;
+                    k += 1;
+                }
+                if s.is_planar() {
+                    normals[k] = -self.faces[s.face as usize].plane.n;
+                    k += 1;
                 }
                 solid_covers(solid, a, b, &normals[..k], self.occ.tolerance())
             }
             _ => false,
+        }
+    }
+
+    /// Up to two triangles' corners, or a box's: on the stack, as `covers` runs for every
+    /// pair under one that a face hid in part.
+    fn hull(&self, n: &Node) -> ([DVec3; 8], usize) {
+        if n.hi - n.lo <= 2 {
+            let mut out = [DVec3::ZERO; 8];
+            for (k, i) in (n.lo..n.hi).enumerate() {
+                let [a, b, c, _] = self.h.corners[i as usize];
+                for (j, v) in [a, b, c].into_iter().enumerate() {
+                    out[3 * k + j] = self.el.positions[v as usize];
+                }
+            }
+            (out, 3 * (n.hi - n.lo) as usize)
+        } else {
+            (corners(n), 8)
         }
     }
 
