@@ -141,6 +141,22 @@ pub fn seen_from(
     k: u32,
     seed: u64,
 ) -> Seen {
+    seen_strata(vis, table, start, s, blockers, k, seed, 0..k.max(1))
+}
+
+/// `seen_from`'s segments for the strata `which` of its `k` only: the rest cast later
+/// give the same segments as one call for all of them.
+#[allow(clippy::too_many_arguments)]
+pub fn seen_strata(
+    vis: &Visibility,
+    table: &AreaTable,
+    start: Start,
+    s: &Node,
+    blockers: Option<&[u32]>,
+    k: u32,
+    seed: u64,
+    mut which: impl Iterator<Item = u32>,
+) -> Seen {
     let h = vis.h;
     let face = match start {
         Start::Point(_, _, f) => f,
@@ -163,15 +179,21 @@ pub fn seen_from(
     let mut ends = [(DVec3::ZERO, DVec3::ZERO, DVec3::ZERO, DVec3::ZERO); BATCH];
     // The face that blocked the last blocked segment, tried first on the next.
     let mut hint = None;
-    for first in (0..k).step_by(BATCH) {
-        let last = (first + BATCH as u32).min(k);
-        for (i, d) in (first..last).zip(draws.iter_mut()) {
+    loop {
+        let mut m = 0;
+        // The draws first: `zip` asks its first iterator first, and a stratum taken when
+        // the batch is full would be lost.
+        for (d, i) in draws.iter_mut().zip(which.by_ref()) {
             *d = segment_draw(table, start, s, k, i, seed);
+            m += 1;
         }
-        for (d, e) in draws[..(last - first) as usize].iter().zip(ends.iter_mut()) {
+        if m == 0 {
+            break;
+        }
+        for (d, e) in draws[..m].iter().zip(ends.iter_mut()) {
             *e = segment_ends(vis, start, d);
         }
-        for &(p, n, y, ny) in &ends[..(last - first) as usize] {
+        for &(p, n, y, ny) in &ends[..m] {
             let d = y - p;
             let (ca, cb) = (n.dot(d), -ny.dot(d));
             if !(ca > 0.0 && cb > 0.0) {
