@@ -211,10 +211,7 @@ pub(super) fn own_visibility(
 #[cfg(test)]
 mod test {
     use super::*;
-    use crate::geom::raycast::Occluders;
-    use crate::indirect::hierarchical::hierarchy::Hierarchy;
-    use crate::indirect::patches::test::grid_elements;
-    use crate::scene::test::face;
+    use crate::indirect::hierarchical::visibility::test::HalfBlocked;
 
     #[test]
     fn a_look_that_a_face_hides_wholly_is_dark_after_its_probe() {
@@ -224,41 +221,10 @@ mod test {
         // alone (z = √(16 · 0.2 / 0.8) = 2 at most after a round of 16) would keep the mean;
         // the blocker covers the pair, so the leaf sees nothing, found by the first round's
         // probe (4 rays).
-        let square = |z: f64, up: bool| {
-            let v = |x, y| DVec3::new(x, y, z);
-            let mut p = vec![v(-1.0, -1.0), v(1.0, -1.0), v(1.0, 1.0), v(-1.0, 1.0)];
-            if !up {
-                p.reverse();
-            }
-            face(&p, DVec3::ONE, DVec3::ZERO)
-        };
-        let v = |x, y| DVec3::new(x, y, 0.5);
-        let half = face(
-            &[v(-3.0, -3.0), v(0.0, -3.0), v(0.0, 3.0), v(-3.0, 3.0)],
-            DVec3::ONE,
-            DVec3::ZERO,
-        );
-        let faces = vec![square(0.0, true), square(1.0, false), half];
-        let el = grid_elements(&faces[..2], 4);
-        let occ = Occluders::new(&faces);
-        let mut h = Hierarchy::build(&faces, &el, |_| true, 0.0);
-        h.set_boxes(&faces, &el);
-        let vis = Visibility {
-            h: &h,
-            faces: &faces,
-            el: &el,
-            occ: &occ,
-            solid_of: &[],
-            occluders: &[],
-        };
-        let table = AreaTable::new(&h);
-        let leaf_at = |face: u32, x: f64| {
-            h.nodes
-                .iter()
-                .find(|n| n.is_leaf() && n.face == face && n.hi_box.x < x)
-                .unwrap()
-        };
-        let (under, over) = (leaf_at(0, -0.2), leaf_at(1, -0.2));
+        let scene = HalfBlocked::new();
+        let (h, vis) = (&scene.h, scene.vis());
+        let table = AreaTable::new(h);
+        let (under, over) = (scene.leaf_at(0, -0.2), scene.leaf_at(1, -0.2));
         let list = vis.blockers(under, over);
         assert_eq!(list.as_deref(), Some(&[2][..]));
         let look = |start| own_visibility(&vis, &table, start, over, list.as_deref(), 0.2, 7, None);

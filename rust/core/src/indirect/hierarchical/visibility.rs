@@ -370,7 +370,7 @@ fn corners(n: &Node) -> [DVec3; 8] {
 }
 
 #[cfg(test)]
-mod test {
+pub(crate) mod test {
     use super::*;
     use crate::indirect::patches::test::grid_elements;
     use crate::scene::test::face;
@@ -384,30 +384,57 @@ mod test {
         face(&p, DVec3::ONE, DVec3::ZERO)
     }
 
+    /// Floor facing up, ceiling facing down (2 × 2, one apart, as 4 × 4 grids of
+    /// elements); a blocker in between covering half (x < 0).
+    pub(crate) struct HalfBlocked {
+        pub faces: Vec<Face>,
+        pub el: Elements,
+        pub occ: Occluders,
+        pub h: Hierarchy,
+    }
+
+    impl HalfBlocked {
+        pub fn new() -> Self {
+            let v = |x, y| DVec3::new(x, y, 0.5);
+            let half = face(
+                &[v(-3.0, -3.0), v(0.0, -3.0), v(0.0, 3.0), v(-3.0, 3.0)],
+                DVec3::ONE,
+                DVec3::ZERO,
+            );
+            let faces = vec![square(0.0, 1.0, true), square(1.0, 1.0, false), half];
+            let el = grid_elements(&faces[..2], 4);
+            let occ = Occluders::new(&faces);
+            let mut h = Hierarchy::build(&faces, &el, |_| true, 0.0);
+            h.set_boxes(&faces, &el);
+            HalfBlocked { faces, el, occ, h }
+        }
+
+        pub fn vis(&self) -> Visibility<'_> {
+            Visibility {
+                h: &self.h,
+                faces: &self.faces,
+                el: &self.el,
+                occ: &self.occ,
+                solid_of: &[],
+                occluders: &[],
+            }
+        }
+
+        /// A leaf of `face` (0 the floor, 1 the ceiling) wholly at x under `x`.
+        pub fn leaf_at(&self, face: u32, x: f64) -> &Node {
+            self.h
+                .nodes
+                .iter()
+                .find(|n| n.is_leaf() && n.face == face && n.hi_box.x < x)
+                .unwrap()
+        }
+    }
+
     #[test]
     fn open_half_and_fully_blocked_pairs() {
-        // Floor facing up, ceiling facing down; a blocker in between covering half (x < 0).
-        let floor = square(0.0, 1.0, true);
-        let ceil = square(1.0, 1.0, false);
-        let v = |x, y| DVec3::new(x, y, 0.5);
-        let half = face(
-            &[v(-3.0, -3.0), v(0.0, -3.0), v(0.0, 3.0), v(-3.0, 3.0)],
-            DVec3::ONE,
-            DVec3::ZERO,
-        );
-        let faces = vec![floor.clone(), ceil.clone(), half];
-        let el = grid_elements(&faces[..2], 4);
-        let occ = Occluders::new(&faces);
-        let mut h = Hierarchy::build(&faces, &el, |_| true, 0.0);
-        h.set_boxes(&faces, &el);
-        let vis = Visibility {
-            h: &h,
-            faces: &faces,
-            el: &el,
-            occ: &occ,
-            solid_of: &[],
-            occluders: &[],
-        };
+        let scene = HalfBlocked::new();
+        let (h, el, vis) = (&scene.h, &scene.el, scene.vis());
+        let (floor, ceil) = (scene.faces[0].clone(), scene.faces[1].clone());
         let [a, b] = h.nodes[0].kids.map(|k| &h.nodes[k as usize]);
         let (f, c) = if a.face == 0 { (a, b) } else { (b, a) };
         assert_eq!(vis.blockers(f, c), Some(vec![2]));
@@ -415,20 +442,15 @@ mod test {
         assert_eq!(rays, 16);
         assert!(v > 0.1 && v < 0.9, "{v}");
         // A leaf wholly under the blocker sees nothing of a leaf over it.
-        let leaf_at = |face: u32, x: f64| {
-            h.nodes
-                .iter()
-                .find(|n| n.is_leaf() && n.face == face && n.hi_box.x < x)
-                .unwrap()
-        };
-        assert_eq!(vis.fraction(leaf_at(0, -0.2), leaf_at(1, -0.2), 4).0, 0.0);
+        let (under, over) = (scene.leaf_at(0, -0.2), scene.leaf_at(1, -0.2));
+        assert_eq!(vis.fraction(under, over, 4).0, 0.0);
         // Without the blocker: no candidates, no rays.
         let faces2 = vec![floor, ceil];
         let occ2 = Occluders::new(&faces2);
         let vis2 = Visibility {
-            h: &h,
+            h,
             faces: &faces2,
-            el: &el,
+            el,
             occ: &occ2,
             solid_of: &[],
             occluders: &[],
