@@ -129,25 +129,12 @@ pub enum Start<'a> {
     Node(&'a Node),
 }
 
-/// `k` stratified segments from `start` to node `s`, drawn from the stream `seed` (a
-/// different seed gives independent strata). `blockers` holds every face that could cross
-/// one (`Visibility::blockers`), or `None` for the BVH.
-pub fn seen_from(
-    vis: &Visibility,
-    table: &AreaTable,
-    start: Start,
-    s: &Node,
-    blockers: Option<&[u32]>,
-    k: u32,
-    seed: u64,
-) -> Seen {
-    seen_strata(vis, table, start, s, blockers, k, seed, 0..k.max(1))
-}
-
-/// `seen_from`'s segments for the strata `which` of its `k` only: the rest cast later
-/// give the same segments as one call for all of them.
+/// The segments of strata `which` (of `k`) from `start` to node `s`, drawn from the stream
+/// `seed` (a different seed gives independent strata); strata cast in several calls give
+/// the same segments as one call for all of them. `blockers` holds every face that could
+/// cross one (`Visibility::blockers`), or `None` for the BVH.
 #[allow(clippy::too_many_arguments)]
-pub fn seen_strata(
+pub fn seen_from(
     vis: &Visibility,
     table: &AreaTable,
     start: Start,

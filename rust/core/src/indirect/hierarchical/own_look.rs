@@ -4,7 +4,7 @@
 
 use glam::DVec3;
 
-use super::from_point::{seen_from, seen_strata, AreaTable, Seen, Start};
+use super::from_point::{seen_from, AreaTable, Seen, Start};
 use super::hierarchy::Node;
 use super::vertices::SCREEN_RAYS;
 use super::visibility::Visibility;
@@ -126,7 +126,16 @@ pub(super) fn own_visibility(
     // agree too, the link's value stands.
     if lv == 0.0 || lv == 1.0 {
         seen = screened.unwrap_or_else(|| {
-            let x = seen_from(vis, table, start, s, blockers, SCREEN_RAYS, seed);
+            let x = seen_from(
+                vis,
+                table,
+                start,
+                s,
+                blockers,
+                SCREEN_RAYS,
+                seed,
+                0..SCREEN_RAYS,
+            );
             rays += x.rays;
             x
         });
@@ -155,7 +164,7 @@ pub(super) fn own_visibility(
         let more = if round == 1 && k == REPLACE_RAYS {
             // A first round probes with every `PROBE`-th stratum first: where a face hides
             // the source, the rest of the round is spared.
-            let mut probe = seen_strata(
+            let mut probe = seen_from(
                 vis,
                 table,
                 start,
@@ -173,12 +182,12 @@ pub(super) fn own_visibility(
                 tried = probe.blocker;
             }
             let rest = (0..k).filter(|i| i % PROBE as u32 != 0);
-            let rest = seen_strata(vis, table, start, s, blockers, k, seed, rest);
+            let rest = seen_from(vis, table, start, s, blockers, k, seed, rest);
             rays += rest.rays;
             probe.add(rest);
             probe
         } else {
-            let more = seen_from(vis, table, start, s, blockers, k, seed);
+            let more = seen_from(vis, table, start, s, blockers, k, seed, 0..k);
             rays += more.rays;
             more
         };
@@ -257,10 +266,10 @@ mod test {
         // than a batch of them: none is lost between batches).
         let k = 40;
         let list = list.as_deref();
-        let all = seen_from(&vis, &table, Start::Node(under), ceiling, list, k, 9);
+        let all = seen_from(&vis, &table, Start::Node(under), ceiling, list, k, 9, 0..k);
         let part = |f: fn(&u32) -> bool| {
             let which = (0..k).filter(f);
-            seen_strata(&vis, &table, Start::Node(under), ceiling, list, k, 9, which)
+            seen_from(&vis, &table, Start::Node(under), ceiling, list, k, 9, which)
         };
         let mut two = part(|i| i % 3 == 0);
         two.add(part(|i| i % 3 != 0));

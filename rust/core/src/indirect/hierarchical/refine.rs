@@ -452,6 +452,7 @@ impl<'a> Refiner<'a> {
             blockers,
             k,
             seed,
+            0..k.max(1),
         );
         (seen.fraction(), seen.rays)
     }

@@ -439,8 +439,18 @@ impl Gather<'_> {
                 let start = Start::Node(ln);
                 // A link whose rays all got through is screened through the BVH first: most
                 // screens agree, and the shaft's blocker list pays only over more rays.
-                let screened = (u.v == 1.0)
-                    .then(|| seen_from(self.vis, &self.table, start, s, None, SCREEN_RAYS, seed));
+                let screened = (u.v == 1.0).then(|| {
+                    seen_from(
+                        self.vis,
+                        &self.table,
+                        start,
+                        s,
+                        None,
+                        SCREEN_RAYS,
+                        seed,
+                        0..SCREEN_RAYS,
+                    )
+                });
                 if let Some(x) = screened {
                     *cast += x.rays as u64;
                 }
