@@ -217,18 +217,21 @@ pub fn indirect(
         direct,
         VISIBILITY_SCALE * settings.convergence,
     );
-    let (mut at, looks) = gather.vertices();
+    let gathered = gather.vertices();
     // New vertices get exact direct light but not the world's, which is sampled per vertex
     // elsewhere (`direct::world`): with world light on, the mesh stays as it is.
-    if settings.world == DVec3::ZERO {
+    let sub = if settings.world == DVec3::ZERO {
         let tol = SUBDIVIDE_SCALE * settings.tolerance;
-        let sub = subdivide::subdivide(
-            scene, &h, faces, el, &gather, &looks, direct, &at, tol, progress,
-        )?;
-        if let Some(sub) = sub {
-            at = sub.indirect.clone();
-            result.subdivided = Some(sub);
-        }
+        subdivide::subdivide(
+            scene, &h, faces, el, &gather, &gathered, direct, tol, progress,
+        )?
+    } else {
+        None
+    };
+    let mut at = gathered.irradiance;
+    if let Some(sub) = sub {
+        at = sub.indirect.clone();
+        result.subdivided = Some(sub);
     }
     result.t_gather = t_gather.elapsed().as_secs_f64();
     result.gather_rays = gather.rays();

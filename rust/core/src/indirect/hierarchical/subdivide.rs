@@ -27,7 +27,7 @@ use rayon::prelude::*;
 
 use super::bisect::{bisect_all, longest, EdgeTris};
 use super::hierarchy::{Hierarchy, NONE};
-use super::vertices::{Gather, LeafLook, Point};
+use super::vertices::{AtVertices, Gather, LeafLook, Point};
 use crate::geom::hash::{IdMap, IdSet};
 use crate::mesh::elements::Elements;
 use crate::progress::Progress;
@@ -119,7 +119,7 @@ struct Known {
     partly: IdMap<u32, bool>,
 }
 
-/// Splits the elements of `el` where the indirect light `indirect` (per vertex, from
+/// Splits the elements of `el` where the indirect light `at.irradiance` (per vertex, from
 /// `gather`) is not linear to within `tol` of the local light (`direct` per vertex plus
 /// indirect, plus a floor); `None` when nothing needed it.
 #[allow(clippy::too_many_arguments)]
@@ -129,12 +129,12 @@ pub fn subdivide(
     faces: &[Face],
     el: &Elements,
     gather: &Gather,
-    looks: &IdMap<u32, LeafLook>,
+    at: &AtVertices,
     direct: &[DVec3],
-    indirect: &[DVec3],
     tol: f64,
     progress: &Progress,
 ) -> Result<Option<Subdivided>, BakeError> {
+    let (indirect, looks) = (&at.irradiance[..], &at.looks);
     let nv = el.positions.len();
     // Elements made without regions (unit tests' grids) have no direct light to split by.
     if nv == 0 || el.tri_region.len() != el.triangles.len() || el.regions.is_empty() {
@@ -293,6 +293,15 @@ pub fn subdivide(
             points.push(point(eval));
             for (k, v) in [(1, a), (2, b)] {
                 if ends.contains_key(&(v, leaf)) {
+                    continue;
+                }
+                // An old vertex on the leaf and face it was gathered on: the gather found
+                // its smooth value at this very point.
+                let u = v as usize;
+                if u < nv && gathered_on[u] == leaf && el.vertex_face[u] == face {
+                    if !at.smooth[u].x.is_nan() {
+                        ends.insert((v, leaf), at.smooth[u]);
+                    }
                     continue;
                 }
                 slot[k] = *asked.entry((v, leaf)).or_insert_with(|| {

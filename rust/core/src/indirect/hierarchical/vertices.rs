@@ -141,26 +141,30 @@ impl<'a> Gather<'a> {
 
     /// Indirect irradiance at every element vertex by a final gather over the links `g`;
     /// vertices on no leaf (under a cover) get 0. Also each gathered leaf's look, for
-    /// points on it later (`looked`).
-    pub fn vertices(&self) -> (Vec<DVec3>, IdMap<u32, LeafLook>) {
+    /// points on it later (`looked`), and each vertex's smooth value on that leaf.
+    pub fn vertices(&self) -> AtVertices {
         let nv = self.el.positions.len();
         // The vertices of each leaf, in index order: they share the links above the leaf,
         // and the shafts from the leaf to those links' sources.
         let by_leaf = self.by_leaf();
         let groups: Vec<&[(u32, u32)]> = by_leaf.chunk_by(|x, y| x.0 == y.0).collect();
-        let per_leaf: Vec<(Vec<(u32, DVec3)>, LeafLook)> = groups
+        let per_leaf: Vec<(Vec<(u32, DVec3, DVec3)>, LeafLook)> = groups
             .par_iter()
             .map(|grp| self.leaf(grp[0].0, &self.chain(grp[0].0), grp))
             .collect();
-        let mut out = vec![DVec3::ZERO; nv];
-        let mut looks = IdMap::with_capacity_and_hasher(groups.len(), Default::default());
+        let mut out = AtVertices {
+            irradiance: vec![DVec3::ZERO; nv],
+            looks: IdMap::with_capacity_and_hasher(groups.len(), Default::default()),
+            smooth: vec![DVec3::NAN; nv],
+        };
         for (grp, (vals, look)) in groups.iter().zip(per_leaf) {
-            for (v, e) in vals {
-                out[v as usize] = e;
+            for (v, e, m) in vals {
+                out.irradiance[v as usize] = e;
+                out.smooth[v as usize] = m;
             }
-            looks.insert(grp[0].0, look);
+            out.looks.insert(grp[0].0, look);
         }
-        (out, looks)
+        out
     }
 
     /// Indirect irradiance at `points` with their links' mean visibilities (no rays): smooth
@@ -182,14 +186,8 @@ impl<'a> Gather<'a> {
                 grp.iter()
                     .map(|&(_, i)| {
                         let q = &points[i as usize];
-                        let mut partly = 0.0;
-                        let (e, _) = self.gathered_at(q.p, q.n, &chain, &unsure, |u, x| {
-                            if u.v > PARTLY && u.v < 1.0 - PARTLY {
-                                partly += x.element_sum() * u.v;
-                            }
-                            0.0
-                        });
-                        (i, (partly <= PARTLY_SHARE * e.element_sum()).then_some(e))
+                        let g = self.gathered_at(q.p, q.n, &chain, &unsure, |_, _| 0.0);
+                        (i, g.smooth())
                     })
                     .collect()
             })
@@ -244,6 +242,41 @@ impl LeafLook {
     }
 }
 
+/// The final gather at the element vertices (`Gather::vertices`).
+pub struct AtVertices {
+    /// Indirect irradiance per vertex.
+    pub irradiance: Vec<DVec3>,
+    /// Each gathered leaf's look.
+    pub looks: IdMap<u32, LeafLook>,
+    /// Each vertex's smooth value (`Gather::smooth`) on the leaf it was gathered on, at the
+    /// point the gather placed it; NaN where the means cannot judge or on no leaf. Made from
+    /// the factors the gather found anyway: `subdivide` asks for these at most of its edges'
+    /// ends, and gathering them again was a fifth of its smooth points (room-245).
+    pub smooth: Vec<DVec3>,
+}
+
+/// What a gather over a leaf's links finds at a point (`Gather::gathered_at`).
+struct Gathered {
+    /// Irradiance with the visibilities given.
+    e: DVec3,
+    /// The error of each unsure link, by the caller's measure.
+    errs: Vec<f64>,
+    /// Irradiance with the links' mean visibilities, summed in the same order, so that it
+    /// is bit for bit what a gather given the means finds.
+    mean: DVec3,
+    /// What links seen in part (mean visibility between `PARTLY` and 1 − `PARTLY`) bring
+    /// to `mean`, channels summed.
+    partly: f64,
+}
+
+impl Gathered {
+    /// The smooth value: the irradiance with the means, unless links seen in part bring
+    /// over `PARTLY_SHARE` of it.
+    fn smooth(&self) -> Option<DVec3> {
+        (self.partly <= PARTLY_SHARE * self.mean.element_sum()).then_some(self.mean)
+    }
+}
+
 impl Gather<'_> {
     /// Each gathered vertex's leaf and the vertex, sorted: the leaf's vertices in the order
     /// the final gather took them (`vertices`).
@@ -288,10 +321,12 @@ impl Gather<'_> {
             (unsure[i as usize].v, unsure[i as usize].varies) = (v, varies);
         }
         let mut xs = Vec::with_capacity(unsure.len());
-        let (mut e, _) = self.gathered_at(q.p, q.n, &chain, &unsure, |_, x| {
-            xs.push(x);
-            0.0
-        });
+        let mut e = self
+            .gathered_at(q.p, q.n, &chain, &unsure, |_, x| {
+                xs.push(x);
+                0.0
+            })
+            .e;
         if look.anchors.is_empty() {
             return e;
         }
@@ -328,6 +363,8 @@ struct Unsure {
     source: u32,
     /// The link's visibility, and the leaf's own where it looked.
     v: f64,
+    /// The link's visibility.
+    mean: f64,
     /// The leaf's rays found the source in part: its vertices may differ.
     varies: bool,
     /// What may stand between the leaf and the source (`Visibility::blockers`), once found.
@@ -353,7 +390,7 @@ impl Gather<'_> {
         leaf: u32,
         chain: &[u32],
         verts: &[(u32, u32)],
-    ) -> (Vec<(u32, DVec3)>, LeafLook) {
+    ) -> (Vec<(u32, DVec3, DVec3)>, LeafLook) {
         // Rays counted here and added to the shared count once per leaf: an atomic add per
         // look made the two threads pass its cache line back and forth.
         let mut rays = 0;
@@ -363,11 +400,11 @@ impl Gather<'_> {
             .map(|&(_, v)| self.el.positions[v as usize])
             .collect();
         if verts.len() <= ANCHORS || !unsure.iter().any(|u| u.varies) {
-            let (out, own): (Vec<(u32, DVec3)>, Vec<Vec<f64>>) = verts
+            let (out, own): (Vec<(u32, DVec3, DVec3)>, Vec<Vec<f64>>) = verts
                 .iter()
                 .map(|&(_, v)| {
-                    let (e, own) = self.at(v, leaf, chain, &unsure, &mut rays);
-                    ((v, e), own)
+                    let (e, m, own) = self.at(v, leaf, chain, &unsure, &mut rays);
+                    ((v, e, m), own)
                 })
                 .unzip();
             self.rays.fetch_add(rays, Ordering::Relaxed);
@@ -375,11 +412,14 @@ impl Gather<'_> {
             return (out, look);
         }
         let anchors = spread(&pos, ANCHORS);
-        let mut out: Vec<(u32, DVec3)> = verts.iter().map(|&(_, v)| (v, DVec3::ZERO)).collect();
+        let mut out: Vec<(u32, DVec3, DVec3)> = verts
+            .iter()
+            .map(|&(_, v)| (v, DVec3::ZERO, DVec3::NAN))
+            .collect();
         let mut seen: Vec<Vec<f64>> = Vec::with_capacity(anchors.len());
         for &i in &anchors {
-            let (e, own) = self.at(verts[i].1, leaf, chain, &unsure, &mut rays);
-            out[i].1 = e;
+            let (e, m, own) = self.at(verts[i].1, leaf, chain, &unsure, &mut rays);
+            (out[i].1, out[i].2) = (e, m);
             seen.push(own);
         }
         let mut own = vec![0.0; unsure.len()];
@@ -389,16 +429,13 @@ impl Gather<'_> {
             }
             let from = anchors.iter().zip(&seen).map(|(&j, f)| (pos[j], &f[..]));
             inverse_square(pos[i], from, &mut own);
-            out[i].1 = self.between(v, leaf, chain, &unsure, &own);
+            (out[i].1, out[i].2) = self.between(v, leaf, chain, &unsure, &own);
         }
         self.rays.fetch_add(rays, Ordering::Relaxed);
         let look = LeafLook::keep(&unsure, anchors.iter().map(|&j| pos[j]).zip(seen));
         (out, look)
     }
 
-    /// The links above `leaf` (ancestors `chain`) whose visibility is a mean, after the
-    /// leaf's own look at them: the largest errors first, until what is left is under the
-    /// tolerance of the light of its darkest point (`darkest`, direct light summed).
     /// The links above a leaf (ancestors `chain`) whose visibility is a mean, with their
     /// links' means.
     fn means(&self, chain: &[u32]) -> Vec<Unsure> {
@@ -410,6 +447,7 @@ impl Gather<'_> {
                     unsure.push(Unsure {
                         source: l.source,
                         v: l.v as f64,
+                        mean: l.v as f64,
                         varies: false,
                         blockers: None,
                     });
@@ -419,6 +457,9 @@ impl Gather<'_> {
         unsure
     }
 
+    /// The links above `leaf` (ancestors `chain`) whose visibility is a mean, after the
+    /// leaf's own look at them: the largest errors first, until what is left is under the
+    /// tolerance of the light of its darkest point (`darkest`, direct light summed).
     fn look(&self, leaf: u32, chain: &[u32], darkest: f64, cast: &mut u64) -> Vec<Unsure> {
         let (h, faces) = (self.h, self.faces);
         let ln = &h.nodes[leaf as usize];
@@ -428,7 +469,7 @@ impl Gather<'_> {
         // is left is under the tolerance of the darkest vertex's light.
         if !unsure.is_empty() {
             let c = ln.centroid;
-            let (e, errs) = self.gathered_at(c, n, chain, &unsure, |u, x| {
+            let Gathered { e, errs, .. } = self.gathered_at(c, n, chain, &unsure, |u, x| {
                 x.element_sum() * u.v.max(1.0 - u.v)
             });
             let allowed = self.tolerance * (e.element_sum() + darkest);
@@ -491,25 +532,33 @@ impl Gather<'_> {
     }
 
     /// Irradiance at a vertex that is not an anchor, with `own` the visibilities of the
-    /// `unsure` links interpolated from the anchors'.
-    fn between(&self, v: u32, leaf: u32, chain: &[u32], unsure: &[Unsure], own: &[f64]) -> DVec3 {
+    /// `unsure` links interpolated from the anchors', and its smooth value (NaN for none).
+    fn between(
+        &self,
+        v: u32,
+        leaf: u32,
+        chain: &[u32],
+        unsure: &[Unsure],
+        own: &[f64],
+    ) -> (DVec3, DVec3) {
         let (p, n, _) = self.place(v, leaf);
         let mut xs = Vec::with_capacity(unsure.len());
-        let (mut e, _) = self.gathered_at(p, n, chain, unsure, |_, x| {
+        let g = self.gathered_at(p, n, chain, unsure, |_, x| {
             xs.push(x);
             0.0
         });
+        let mut e = g.e;
         for ((u, x), o) in unsure.iter().zip(xs).zip(own) {
             if u.varies {
                 e += x * (o - u.v);
             }
         }
-        e
+        (e, g.smooth().unwrap_or(DVec3::NAN))
     }
 
     /// Irradiance at `p` (normal `n`) over the links of `chain`, with the visibilities of
     /// `unsure` in place of their links', and for each of those its error by `err`
-    /// (given what its source gives `p` unhidden).
+    /// (given what its source gives `p` unhidden); also with the links' own.
     fn gathered_at(
         &self,
         p: DVec3,
@@ -517,37 +566,48 @@ impl Gather<'_> {
         chain: &[u32],
         unsure: &[Unsure],
         mut err: impl FnMut(&Unsure, DVec3) -> f64,
-    ) -> (DVec3, Vec<f64>) {
+    ) -> Gathered {
         let (h, g) = (self.h, self.g);
-        let mut e = DVec3::ZERO;
-        let mut errs = Vec::with_capacity(unsure.len());
+        let mut out = Gathered {
+            e: DVec3::ZERO,
+            errs: Vec::with_capacity(unsure.len()),
+            mean: DVec3::ZERO,
+            partly: 0.0,
+        };
         let mut next = 0;
         for &a in chain {
             for l in &g.links[self.links(g, a)] {
                 let s = &h.nodes[l.source as usize];
                 if !s.is_planar() {
                     let (k, u) = point_coefficient(h, self.faces, self.el, p, n, s);
-                    e += self.solver.sent(self.b, l.source, u) * (k * l.v as f64);
+                    let x = self.solver.sent(self.b, l.source, u) * (k * l.v as f64);
+                    out.e += x;
+                    out.mean += x;
                     continue;
                 }
                 let x = self.unhidden(p, n, l.source);
                 if l.clear {
-                    e += x * l.v as f64;
+                    out.e += x * l.v as f64;
+                    out.mean += x * l.v as f64;
                 } else {
                     let u = &unsure[next];
                     next += 1;
-                    e += x * u.v;
-                    errs.push(err(u, x));
+                    out.e += x * u.v;
+                    out.mean += x * u.mean;
+                    if u.mean > PARTLY && u.mean < 1.0 - PARTLY {
+                        out.partly += x.element_sum() * u.mean;
+                    }
+                    out.errs.push(err(u, x));
                 }
             }
         }
-        (e, errs)
+        out
     }
 
     /// Irradiance at vertex `v` of `leaf` (ancestors `chain`), given the leaf's look at its
     /// `unsure` links: the vertex looks itself at those the leaf found in part. Also returns
-    /// the visibility it used for each of `unsure` (the link's where it did not look); the
-    /// rays it cast are added to `cast`.
+    /// its smooth value (NaN for none) and the visibility it used for each of `unsure` (the
+    /// link's where it did not look); the rays it cast are added to `cast`.
     fn at(
         &self,
         v: u32,
@@ -555,7 +615,7 @@ impl Gather<'_> {
         chain: &[u32],
         unsure: &[Unsure],
         cast: &mut u64,
-    ) -> (DVec3, Vec<f64>) {
+    ) -> (DVec3, DVec3, Vec<f64>) {
         let seed = v as u64;
         self.at_point(
             self.place(v, leaf),
@@ -577,10 +637,10 @@ impl Gather<'_> {
         chain: &[u32],
         unsure: &[Unsure],
         cast: &mut u64,
-    ) -> (DVec3, Vec<f64>) {
+    ) -> (DVec3, DVec3, Vec<f64>) {
         let h = self.h;
         let mut xs = Vec::with_capacity(unsure.len());
-        let (mut e, errs) = self.gathered_at(p, n, chain, unsure, |u, x| {
+        let g = self.gathered_at(p, n, chain, unsure, |u, x| {
             xs.push(x);
             if u.varies {
                 x.element_sum() * u.v.max(1.0 - u.v)
@@ -588,9 +648,10 @@ impl Gather<'_> {
                 0.0
             }
         });
+        let mut e = g.e;
         let allowed = self.tolerance * (e + direct).element_sum();
         let mut used: Vec<f64> = unsure.iter().map(|u| u.v).collect();
-        for i in by_error(&errs, allowed) {
+        for i in by_error(&g.errs, allowed) {
             let u = &unsure[i];
             let s = &h.nodes[u.source as usize];
             let list = u.blockers.as_ref().and_then(|b| b.as_deref());
@@ -602,6 +663,6 @@ impl Gather<'_> {
             e += xs[i] * (own - u.v);
             used[i] = own;
         }
-        (e, used)
+        (e, g.smooth().unwrap_or(DVec3::NAN), used)
     }
 }
