@@ -266,7 +266,10 @@ pub fn subdivide(
         new_leaves.dedup();
         let found: Vec<(u32, bool)> = new_leaves
             .par_iter()
-            .map(|&l| (l, gather.partly_seen(l)))
+            .map(|&l| {
+                let known = looks.get(&l).and_then(|k| k.partly);
+                (l, known.unwrap_or_else(|| gather.partly_seen(l)))
+            })
             .collect();
         partly.extend(found);
         let mut which = Vec::new();

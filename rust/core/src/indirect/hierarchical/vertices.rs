@@ -211,12 +211,20 @@ impl<'a> Gather<'a> {
 pub struct LeafLook {
     changed: Vec<(u32, f64, bool)>,
     anchors: Vec<(DVec3, Vec<f64>)>,
+    /// `Gather::partly_seen` of the leaf, where the look gathered at its centre (it does
+    /// where a link's visibility is a mean).
+    pub partly: Option<bool>,
 }
 
 impl LeafLook {
     /// What the leaf's look at its `unsure` links and its `anchors` (position, and the
-    /// visibility each used for every unsure link) keep of it.
-    fn keep(unsure: &[Unsure], anchors: impl Iterator<Item = (DVec3, Vec<f64>)>) -> Self {
+    /// visibility each used for every unsure link) keep of it, and whether it is `partly`
+    /// seen.
+    fn keep(
+        unsure: &[Unsure],
+        partly: Option<bool>,
+        anchors: impl Iterator<Item = (DVec3, Vec<f64>)>,
+    ) -> Self {
         let changed = unsure
             .iter()
             .enumerate()
@@ -238,7 +246,11 @@ impl LeafLook {
         } else {
             Vec::new()
         };
-        LeafLook { changed, anchors }
+        LeafLook {
+            changed,
+            anchors,
+            partly,
+        }
     }
 }
 
@@ -394,7 +406,7 @@ impl Gather<'_> {
         // Rays counted here and added to the shared count once per leaf: an atomic add per
         // look made the two threads pass its cache line back and forth.
         let mut rays = 0;
-        let unsure = self.look(leaf, chain, self.darkest(verts), &mut rays);
+        let (unsure, partly) = self.look(leaf, chain, self.darkest(verts), &mut rays);
         let pos: Vec<DVec3> = verts
             .iter()
             .map(|&(_, v)| self.el.positions[v as usize])
@@ -408,7 +420,7 @@ impl Gather<'_> {
                 })
                 .unzip();
             self.rays.fetch_add(rays, Ordering::Relaxed);
-            let look = LeafLook::keep(&unsure, pos.into_iter().zip(own));
+            let look = LeafLook::keep(&unsure, partly, pos.into_iter().zip(own));
             return (out, look);
         }
         let anchors = spread(&pos, ANCHORS);
@@ -432,7 +444,8 @@ impl Gather<'_> {
             (out[i].1, out[i].2) = self.between(v, leaf, chain, &unsure, &own);
         }
         self.rays.fetch_add(rays, Ordering::Relaxed);
-        let look = LeafLook::keep(&unsure, anchors.iter().map(|&j| pos[j]).zip(seen));
+        let anchors = anchors.iter().map(|&j| pos[j]).zip(seen);
+        let look = LeafLook::keep(&unsure, partly, anchors);
         (out, look)
     }
 
@@ -459,19 +472,29 @@ impl Gather<'_> {
 
     /// The links above `leaf` (ancestors `chain`) whose visibility is a mean, after the
     /// leaf's own look at them: the largest errors first, until what is left is under the
-    /// tolerance of the light of its darkest point (`darkest`, direct light summed).
-    fn look(&self, leaf: u32, chain: &[u32], darkest: f64, cast: &mut u64) -> Vec<Unsure> {
+    /// tolerance of the light of its darkest point (`darkest`, direct light summed). Also
+    /// `partly_seen` of the leaf, which its gather at the centre tells, where it made one.
+    fn look(
+        &self,
+        leaf: u32,
+        chain: &[u32],
+        darkest: f64,
+        cast: &mut u64,
+    ) -> (Vec<Unsure>, Option<bool>) {
         let (h, faces) = (self.h, self.faces);
         let ln = &h.nodes[leaf as usize];
         let n = faces[ln.face as usize].plane.n;
         let mut unsure = self.means(chain);
+        let mut partly = None;
         // The leaf's look, at its centroid's values: the largest errors first, until what
         // is left is under the tolerance of the darkest vertex's light.
         if !unsure.is_empty() {
             let c = ln.centroid;
-            let Gathered { e, errs, .. } = self.gathered_at(c, n, chain, &unsure, |u, x| {
+            let g = self.gathered_at(c, n, chain, &unsure, |u, x| {
                 x.element_sum() * u.v.max(1.0 - u.v)
             });
+            partly = Some(g.smooth().is_none());
+            let Gathered { e, errs, .. } = g;
             let allowed = self.tolerance * (e.element_sum() + darkest);
             for i in by_error(&errs, allowed) {
                 let u = &mut unsure[i];
@@ -513,7 +536,7 @@ impl Gather<'_> {
                 (u.v, u.varies, u.blockers) = (v, varies, Some(list));
             }
         }
-        unsure
+        (unsure, partly)
     }
 
     /// Where vertex `v` of `leaf` is and faces, a hair towards the leaf's centre: a vertex on
