@@ -129,8 +129,8 @@ pub struct SettingsJson {
     /// around each vertex) or "exact" (the light at the vertex).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub vertex_values: Option<String>,
-    /// "progressive" (default: progressive refinement over patches) or "hierarchical"
-    /// (hierarchical radiosity with clustering, for large scenes).
+    /// "hierarchical" (default: hierarchical radiosity with clustering) or "progressive"
+    /// (round 1's progressive refinement over patches).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub indirect_solver: Option<String>,
     /// "discontinuity" (default) or "uniform": a uniform mesh of `element_size`, with exact

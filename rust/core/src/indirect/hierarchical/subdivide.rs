@@ -27,7 +27,7 @@ use rayon::prelude::*;
 
 use super::bisect::{bisect_all, longest, EdgeTris};
 use super::hierarchy::{Hierarchy, NONE};
-use super::vertices::{AtVertices, Gather, LeafLook, Point};
+use super::vertices::{AtVertices, Gather, Point};
 use crate::geom::hash::{IdMap, IdSet};
 use crate::mesh::elements::Elements;
 use crate::progress::Progress;
@@ -349,15 +349,13 @@ pub fn subdivide(
             value[i] = m + 0.5 * own;
             judged[i] = Judged::Smooth(m);
         }
-        let none = LeafLook::default();
-        let at = |q: DVec3, leaf: u32, t: u32| {
+        let point = |q: DVec3, leaf: u32, t: u32| {
             let face = el.tri_face[origin[t as usize] as usize];
-            let point = Point {
+            Point {
                 p: nudge(q, leaf),
                 n: faces[face as usize].plane.n,
                 leaf,
-            };
-            gather.looked(looks.get(&leaf).unwrap_or(&none), &point)
+            }
         };
         // The ends first, each once per leaf (an end serves the edges around it).
         let mut end_todo: Vec<(u32, u32, u32)> = Vec::new();
@@ -373,29 +371,40 @@ pub fn subdivide(
         end_todo.dedup_by_key(|x| (x.0, x.1));
         // An old vertex on the leaf and face it was gathered on has that value already: the
         // final gather's, by the same look (a pass's first `looked` calls were half of them).
-        let end_vals: Vec<((u32, u32), DVec3)> = end_todo
-            .par_iter()
-            .map(|&(v, leaf, t)| {
-                let u = v as usize;
-                let gathered = u < nv
-                    && gathered_on[u] == leaf
-                    && el.vertex_face[u] == el.tri_face[origin[t as usize] as usize];
-                let e = if gathered {
-                    indirect[u]
-                } else {
-                    at(eval_at(out, u), leaf, t)
-                };
-                ((v, leaf), e)
-            })
+        let (gathered, fresh): (Vec<_>, Vec<_>) = end_todo.iter().partition(|&&(v, leaf, t)| {
+            let u = v as usize;
+            u < nv
+                && gathered_on[u] == leaf
+                && el.vertex_face[u] == el.tri_face[origin[t as usize] as usize]
+        });
+        seen_ends.extend(
+            gathered
+                .iter()
+                .map(|&(v, leaf, _)| ((v, leaf), indirect[v as usize])),
+        );
+        let at: Vec<Point> = fresh
+            .iter()
+            .map(|&(v, leaf, t)| point(eval_at(out, v as usize), leaf, t))
             .collect();
-        seen_ends.extend(end_vals);
+        let vals = gather.looked(looks, &at);
+        seen_ends.extend(
+            fresh
+                .iter()
+                .zip(vals)
+                .map(|(&(v, leaf, _), e)| ((v, leaf), e)),
+        );
         let seen_ends = &*seen_ends;
+        let at: Vec<Point> = looked
+            .iter()
+            .map(|&(i, t)| point(lit[i].0, leaf_of[i], t))
+            .collect();
+        let at_mids = gather.looked(looks, &at);
         let by_look: Vec<(usize, f64, DVec3, DVec3)> = looked
-            .par_iter()
-            .map(|&(i, t)| {
+            .iter()
+            .zip(at_mids)
+            .map(|(&(i, _), m)| {
                 let ((a, b), _) = todo[i];
                 let leaf = leaf_of[i];
-                let m = at(lit[i].0, leaf, t);
                 let la = seen_ends[&(a, leaf)];
                 let lb = seen_ends[&(b, leaf)];
                 let err = (m - 0.5 * (la + lb)).abs().element_sum();

@@ -173,28 +173,43 @@ impl<'a> Gather<'a> {
     /// `PARTLY_SHARE` of the light: there a mean says little of a point (a slot between two
     /// boxes, lit by means over its mouth).
     pub fn smooth(&self, points: &[Point]) -> Vec<Option<DVec3>> {
+        self.leaf_by_leaf(points, None, |_, chain, q| {
+            let unsure = self.means(chain);
+            q.map(|q| {
+                self.gathered_at(q.p, q.n, chain, &unsure, |_, _| 0.0)
+                    .smooth()
+            })
+            .collect()
+        })
+    }
+
+    /// `f(leaf, its chain, its points)` for the leaf of each of `points` (on all threads):
+    /// the points of a leaf share its links, found once. The values `f` gives, in the
+    /// order of `points`.
+    fn leaf_by_leaf<'p, T: Copy + Send + Sync>(
+        &self,
+        points: &'p [Point],
+        fill: T,
+        f: impl Fn(u32, &[u32], &mut dyn Iterator<Item = &'p Point>) -> Vec<T> + Sync,
+    ) -> Vec<T> {
         let mut by_leaf: Vec<(u32, u32)> = (0..points.len() as u32)
             .map(|i| (points[i as usize].leaf, i))
             .collect();
         by_leaf.sort_unstable();
         let groups: Vec<&[(u32, u32)]> = by_leaf.chunk_by(|x, y| x.0 == y.0).collect();
-        let per_leaf: Vec<Vec<(u32, Option<DVec3>)>> = groups
+        let per_leaf: Vec<Vec<T>> = groups
             .par_iter()
             .map(|grp| {
-                let chain = self.chain(grp[0].0);
-                let unsure = self.means(&chain);
-                grp.iter()
-                    .map(|&(_, i)| {
-                        let q = &points[i as usize];
-                        let g = self.gathered_at(q.p, q.n, &chain, &unsure, |_, _| 0.0);
-                        (i, g.smooth())
-                    })
-                    .collect()
+                let leaf = grp[0].0;
+                let mut q = grp.iter().map(|&(_, i)| &points[i as usize]);
+                f(leaf, &self.chain(leaf), &mut q)
             })
             .collect();
-        let mut out = vec![None; points.len()];
-        for (i, e) in per_leaf.into_iter().flatten() {
-            out[i as usize] = e;
+        let mut out = vec![fill; points.len()];
+        for (grp, vals) in groups.iter().zip(per_leaf) {
+            for (&(_, i), e) in grp.iter().zip(vals) {
+                out[i as usize] = e;
+            }
         }
         out
     }
@@ -322,19 +337,29 @@ impl Gather<'_> {
         self.smooth(std::slice::from_ref(&q))[0].is_none()
     }
 
-    /// Indirect irradiance at `q` (on the leaf of `look`) with the leaf's visibilities, and
-    /// its anchors' interpolated by inverse square distance where they differ over it: no
-    /// new rays, and the values the final gather would give a vertex there that is not an
-    /// anchor.
-    pub fn looked(&self, look: &LeafLook, q: &Point) -> DVec3 {
-        let chain = self.chain(q.leaf);
-        let mut unsure = self.means(&chain);
-        for &(i, v, varies) in &look.changed {
-            (unsure[i as usize].v, unsure[i as usize].varies) = (v, varies);
-        }
+    /// Indirect irradiance at `points` with their leaves' visibilities (`looks`; a leaf
+    /// with none keeps its links' means), and its anchors' interpolated by inverse square
+    /// distance where they differ over it: no new rays, and the values the final gather
+    /// would give a vertex there that is not an anchor. The points are taken leaf by leaf,
+    /// each leaf's links once.
+    pub fn looked(&self, looks: &IdMap<u32, LeafLook>, points: &[Point]) -> Vec<DVec3> {
+        let none = LeafLook::default();
+        self.leaf_by_leaf(points, DVec3::ZERO, |leaf, chain, q| {
+            let look = looks.get(&leaf).unwrap_or(&none);
+            let mut unsure = self.means(chain);
+            for &(i, v, varies) in &look.changed {
+                (unsure[i as usize].v, unsure[i as usize].varies) = (v, varies);
+            }
+            q.map(|q| self.looked_at(look, chain, &unsure, q)).collect()
+        })
+    }
+
+    /// `looked` at one point `q` of the leaf of `look`, whose ancestors are `chain` and
+    /// unsure links `unsure`, with the look's visibilities.
+    fn looked_at(&self, look: &LeafLook, chain: &[u32], unsure: &[Unsure], q: &Point) -> DVec3 {
         let mut xs = Vec::with_capacity(unsure.len());
         let mut e = self
-            .gathered_at(q.p, q.n, &chain, &unsure, |_, x| {
+            .gathered_at(q.p, q.n, chain, unsure, |_, x| {
                 xs.push(x);
                 0.0
             })
