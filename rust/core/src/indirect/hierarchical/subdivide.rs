@@ -119,8 +119,8 @@ struct Known {
     partly: IdMap<u32, bool>,
 }
 
-/// Splits the elements of `el` where the indirect light `at.irradiance` (per vertex, from
-/// `gather`) is not linear to within `tol` of the local light (`direct` per vertex plus
+/// Splits the elements of `el` where the indirect light `at_vertices.irradiance` (per
+/// vertex, from `gather`) is not linear to within `tol` of the local light (`direct` per vertex plus
 /// indirect, plus a floor); `None` when nothing needed it.
 #[allow(clippy::too_many_arguments)]
 pub fn subdivide(
@@ -129,12 +129,12 @@ pub fn subdivide(
     faces: &[Face],
     el: &Elements,
     gather: &Gather,
-    at: &AtVertices,
+    at_vertices: &AtVertices,
     direct: &[DVec3],
     tol: f64,
     progress: &Progress,
 ) -> Result<Option<Subdivided>, BakeError> {
-    let (indirect, looks) = (&at.irradiance[..], &at.looks);
+    let (indirect, looks) = (&at_vertices.irradiance[..], &at_vertices.looks);
     let nv = el.positions.len();
     // Elements made without regions (unit tests' grids) have no direct light to split by.
     if nv == 0 || el.tri_region.len() != el.triangles.len() || el.regions.is_empty() {
@@ -190,6 +190,12 @@ pub fn subdivide(
     let mut origin: Vec<u32> = (0..el.triangles.len() as u32).collect();
     let mut known = Known::default();
     let gathered_on = gather.leaf_of();
+    // Whether vertex `v` is an old one, gathered on `leaf` and on `face`: the final gather
+    // found its values at the very point that `leaf` and `face` place it.
+    let gathered_here = |v: u32, leaf: u32, face: u32| {
+        let u = v as usize;
+        u < nv && gathered_on[u] == leaf && el.vertex_face[u] == face
+    };
     let max_vertices = nv + MAX_ADDED_PER_VERTEX * nv;
     let key = |a: u32, b: u32| (a.min(b), a.max(b));
 
@@ -298,12 +304,10 @@ pub fn subdivide(
                 if ends.contains_key(&(v, leaf)) {
                     continue;
                 }
-                // An old vertex on the leaf and face it was gathered on: the gather found
-                // its smooth value at this very point.
-                let u = v as usize;
-                if u < nv && gathered_on[u] == leaf && el.vertex_face[u] == face {
-                    if !at.smooth[u].x.is_nan() {
-                        ends.insert((v, leaf), at.smooth[u]);
+                if gathered_here(v, leaf, face) {
+                    let m = at_vertices.smooth[v as usize];
+                    if !m.x.is_nan() {
+                        ends.insert((v, leaf), m);
                     }
                     continue;
                 }
@@ -371,22 +375,19 @@ pub fn subdivide(
         end_todo.dedup_by_key(|x| (x.0, x.1));
         // An old vertex on the leaf and face it was gathered on has that value already: the
         // final gather's, by the same look (a pass's first `looked` calls were half of them).
-        let (gathered, fresh): (Vec<_>, Vec<_>) = end_todo.iter().partition(|&&(v, leaf, t)| {
-            let u = v as usize;
-            u < nv
-                && gathered_on[u] == leaf
-                && el.vertex_face[u] == el.tri_face[origin[t as usize] as usize]
+        let (known_ends, fresh): (Vec<_>, Vec<_>) = end_todo.iter().partition(|&&(v, leaf, t)| {
+            gathered_here(v, leaf, el.tri_face[origin[t as usize] as usize])
         });
         seen_ends.extend(
-            gathered
+            known_ends
                 .iter()
                 .map(|&(v, leaf, _)| ((v, leaf), indirect[v as usize])),
         );
-        let at: Vec<Point> = fresh
+        let fresh_at: Vec<Point> = fresh
             .iter()
             .map(|&(v, leaf, t)| point(eval_at(out, v as usize), leaf, t))
             .collect();
-        let vals = gather.looked(looks, &at);
+        let vals = gather.looked(looks, &fresh_at);
         seen_ends.extend(
             fresh
                 .iter()
@@ -394,11 +395,11 @@ pub fn subdivide(
                 .map(|(&(v, leaf, _), e)| ((v, leaf), e)),
         );
         let seen_ends = &*seen_ends;
-        let at: Vec<Point> = looked
+        let mids_at: Vec<Point> = looked
             .iter()
             .map(|&(i, t)| point(lit[i].0, leaf_of[i], t))
             .collect();
-        let at_mids = gather.looked(looks, &at);
+        let at_mids = gather.looked(looks, &mids_at);
         let by_look: Vec<(usize, f64, DVec3, DVec3)> = looked
             .iter()
             .zip(at_mids)
