@@ -148,7 +148,7 @@ impl<'a> Gather<'a> {
         // and the shafts from the leaf to those links' sources.
         let by_leaf = self.by_leaf();
         let groups: Vec<&[(u32, u32)]> = by_leaf.chunk_by(|x, y| x.0 == y.0).collect();
-        let per_leaf: Vec<(Vec<(u32, DVec3, DVec3)>, LeafLook)> = groups
+        let per_leaf: Vec<(Vec<(u32, DVec3, Option<DVec3>)>, LeafLook)> = groups
             .par_iter()
             .map(|grp| self.leaf(grp[0].0, &self.chain(grp[0].0), grp))
             .collect();
@@ -160,7 +160,7 @@ impl<'a> Gather<'a> {
         for (grp, (vals, look)) in groups.iter().zip(per_leaf) {
             for (v, e, m) in vals {
                 out.irradiance[v as usize] = e;
-                out.smooth[v as usize] = m;
+                out.smooth[v as usize] = m.unwrap_or(DVec3::NAN);
             }
             out.looks.insert(grp[0].0, look);
         }
@@ -427,7 +427,7 @@ impl Gather<'_> {
         leaf: u32,
         chain: &[u32],
         verts: &[(u32, u32)],
-    ) -> (Vec<(u32, DVec3, DVec3)>, LeafLook) {
+    ) -> (Vec<(u32, DVec3, Option<DVec3>)>, LeafLook) {
         // Rays counted here and added to the shared count once per leaf: an atomic add per
         // look made the two threads pass its cache line back and forth.
         let mut rays = 0;
@@ -437,7 +437,7 @@ impl Gather<'_> {
             .map(|&(_, v)| self.el.positions[v as usize])
             .collect();
         if verts.len() <= ANCHORS || !unsure.iter().any(|u| u.varies) {
-            let (out, own): (Vec<(u32, DVec3, DVec3)>, Vec<Vec<f64>>) = verts
+            let (out, own): (Vec<(u32, DVec3, Option<DVec3>)>, Vec<Vec<f64>>) = verts
                 .iter()
                 .map(|&(_, v)| {
                     let (e, m, own) = self.at(v, leaf, chain, &unsure, &mut rays);
@@ -449,10 +449,8 @@ impl Gather<'_> {
             return (out, look);
         }
         let anchors = spread(&pos, ANCHORS);
-        let mut out: Vec<(u32, DVec3, DVec3)> = verts
-            .iter()
-            .map(|&(_, v)| (v, DVec3::ZERO, DVec3::NAN))
-            .collect();
+        let mut out: Vec<(u32, DVec3, Option<DVec3>)> =
+            verts.iter().map(|&(_, v)| (v, DVec3::ZERO, None)).collect();
         let mut seen: Vec<Vec<f64>> = Vec::with_capacity(anchors.len());
         for &i in &anchors {
             let (e, m, own) = self.at(verts[i].1, leaf, chain, &unsure, &mut rays);
@@ -580,7 +578,7 @@ impl Gather<'_> {
     }
 
     /// Irradiance at a vertex that is not an anchor, with `own` the visibilities of the
-    /// `unsure` links interpolated from the anchors', and its smooth value (NaN for none).
+    /// `unsure` links interpolated from the anchors', and its smooth value.
     fn between(
         &self,
         v: u32,
@@ -588,7 +586,7 @@ impl Gather<'_> {
         chain: &[u32],
         unsure: &[Unsure],
         own: &[f64],
-    ) -> (DVec3, DVec3) {
+    ) -> (DVec3, Option<DVec3>) {
         let (p, n, _) = self.place(v, leaf);
         let mut xs = Vec::with_capacity(unsure.len());
         let g = self.gathered_at(p, n, chain, unsure, |_, x| {
@@ -601,7 +599,7 @@ impl Gather<'_> {
                 e += x * (o - u.v);
             }
         }
-        (e, g.smooth().unwrap_or(DVec3::NAN))
+        (e, g.smooth())
     }
 
     /// Irradiance at `p` (normal `n`) over the links of `chain`, with the visibilities of
@@ -654,7 +652,7 @@ impl Gather<'_> {
 
     /// Irradiance at vertex `v` of `leaf` (ancestors `chain`), given the leaf's look at its
     /// `unsure` links: the vertex looks itself at those the leaf found in part. Also returns
-    /// its smooth value (NaN for none) and the visibility it used for each of `unsure` (the
+    /// its smooth value and the visibility it used for each of `unsure` (the
     /// link's where it did not look); the rays it cast are added to `cast`.
     fn at(
         &self,
@@ -663,7 +661,7 @@ impl Gather<'_> {
         chain: &[u32],
         unsure: &[Unsure],
         cast: &mut u64,
-    ) -> (DVec3, DVec3, Vec<f64>) {
+    ) -> (DVec3, Option<DVec3>, Vec<f64>) {
         let seed = v as u64;
         self.at_point(
             self.place(v, leaf),
@@ -685,7 +683,7 @@ impl Gather<'_> {
         chain: &[u32],
         unsure: &[Unsure],
         cast: &mut u64,
-    ) -> (DVec3, DVec3, Vec<f64>) {
+    ) -> (DVec3, Option<DVec3>, Vec<f64>) {
         let h = self.h;
         let mut xs = Vec::with_capacity(unsure.len());
         let g = self.gathered_at(p, n, chain, unsure, |u, x| {
@@ -711,6 +709,6 @@ impl Gather<'_> {
             e += xs[i] * (own - u.v);
             used[i] = own;
         }
-        (e, g.smooth().unwrap_or(DVec3::NAN), used)
+        (e, g.smooth(), used)
     }
 }
