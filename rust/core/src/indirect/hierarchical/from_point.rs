@@ -107,8 +107,8 @@ fn at_or_below(c: &[f64], x: f64) -> usize {
 }
 
 /// Sums of a run of rays from a point to a node: kernel over the open segments and over
-/// all, the sum of squared kernels (for the effective count) and the rays cast; and the
-/// face that blocked the last blocked segment.
+/// all, the sum of squared kernels (for the effective count) and the rays cast; the face
+/// that blocked the last blocked segment; and from a node, where on it the rays started.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Seen {
     pub open: f64,
@@ -116,6 +116,50 @@ pub struct Seen {
     pub total_sq: f64,
     pub rays: u32,
     pub blocker: Option<u32>,
+    pub starts: Starts,
+}
+
+/// Kernel-weighted moments of the start points of a run of rays from a node, about the
+/// node's centroid (offset `d`): Σw·d, Σw·d·dᵀ (xx, yy, zz, xy, xz, yz) and Σw·d over the
+/// open segments. The slope of the visibility over the node is fitted to them
+/// (`own_look::slope`).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Starts {
+    pub d: DVec3,
+    pub dd: [f64; 6],
+    pub open_d: DVec3,
+}
+
+impl Starts {
+    pub(super) fn add_ray(&mut self, w: f64, d: DVec3, open: bool) {
+        let wd = w * d;
+        self.d += wd;
+        self.dd[0] += wd.x * d.x;
+        self.dd[1] += wd.y * d.y;
+        self.dd[2] += wd.z * d.z;
+        self.dd[3] += wd.x * d.y;
+        self.dd[4] += wd.x * d.z;
+        self.dd[5] += wd.y * d.z;
+        if open {
+            self.open_d += wd;
+        }
+    }
+
+    fn add(&mut self, o: &Starts) {
+        self.d += o.d;
+        for (a, b) in self.dd.iter_mut().zip(o.dd) {
+            *a += b;
+        }
+        self.open_d += o.open_d;
+    }
+
+    /// `aᵀ·(Σw·d·dᵀ)·b`.
+    pub(super) fn second(&self, a: DVec3, b: DVec3) -> f64 {
+        let [xx, yy, zz, xy, xz, yz] = self.dd;
+        a.x * (xx * b.x + xy * b.y + xz * b.z)
+            + a.y * (xy * b.x + yy * b.y + yz * b.z)
+            + a.z * (xz * b.x + yz * b.y + zz * b.z)
+    }
 }
 
 impl Seen {
@@ -140,6 +184,7 @@ impl Seen {
         self.total_sq += o.total_sq;
         self.rays += o.rays;
         self.blocker = o.blocker.or(self.blocker);
+        self.starts.add(&o.starts);
     }
 }
 
@@ -179,6 +224,10 @@ pub fn seen_from(
     if s.hi <= s.lo || matches!(start, Start::Node(r) if r.hi <= r.lo) {
         return out;
     }
+    let centre = match start {
+        Start::Node(r) => Some(r.centroid),
+        Start::Point(..) => None,
+    };
     let k = k.max(1);
     // The points first, then the rays: finding a point misses cache (the area table's
     // search, the corners, the vertices), and apart from the traversals the processor
@@ -221,6 +270,9 @@ pub fn seen_from(
                 out.open += w;
             } else {
                 hint = hit;
+            }
+            if let Some(c) = centre {
+                out.starts.add_ray(w, p - c, hit.is_none());
             }
         }
     }
