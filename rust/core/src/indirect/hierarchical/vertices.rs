@@ -228,7 +228,9 @@ impl<'a> Gather<'a> {
 /// bake (perf samples).
 #[derive(Default)]
 pub struct LeafLook {
-    changed: Vec<(u32, f64, bool, Option<Slope>)>,
+    changed: Vec<(u32, f64, bool)>,
+    /// The slopes among them (`Unsure::slope`), apart: most changed links have none.
+    slopes: Vec<(u32, Slope)>,
     anchors: Vec<(DVec3, Vec<f64>)>,
     /// `Gather::partly_seen` of the leaf, where the look gathered at its centre (it does
     /// where a link's visibility is a mean).
@@ -248,7 +250,12 @@ impl LeafLook {
             .iter()
             .enumerate()
             .filter(|(_, u)| u.blockers.is_some())
-            .map(|(i, u)| (i as u32, u.v, u.varies, u.slope))
+            .map(|(i, u)| (i as u32, u.v, u.varies))
+            .collect();
+        let slopes = unsure
+            .iter()
+            .enumerate()
+            .filter_map(|(i, u)| Some((i as u32, u.slope?)))
             .collect();
         let anchors = if unsure.iter().any(|u| u.varies) {
             anchors
@@ -267,6 +274,7 @@ impl LeafLook {
         };
         LeafLook {
             changed,
+            slopes,
             anchors,
             partly,
         }
@@ -343,9 +351,11 @@ impl Gather<'_> {
         self.leaf_by_leaf(points, DVec3::ZERO, |leaf, chain, q| {
             let look = looks.get(&leaf).unwrap_or(&none);
             let mut unsure = self.means(chain);
-            for &(i, v, varies, slope) in &look.changed {
-                let u = &mut unsure[i as usize];
-                (u.v, u.varies, u.slope) = (v, varies, slope);
+            for &(i, v, varies) in &look.changed {
+                (unsure[i as usize].v, unsure[i as usize].varies) = (v, varies);
+            }
+            for &(i, slope) in &look.slopes {
+                unsure[i as usize].slope = Some(slope);
             }
             q.map(|q| self.looked_at(look, chain, &unsure, q)).collect()
         })
