@@ -70,6 +70,16 @@ fn sized_elements(faces: &[Face], size: f64) -> Elements {
     el
 }
 
+/// The indirect light of `sc` on elements about `size` across (`sized_elements`), with the
+/// direct light `direct(face)` at every vertex of each face.
+fn bake_sized(sc: &Scene, size: f64, direct: impl Fn(u32) -> DVec3) -> (Elements, IndirectResult) {
+    let el = sized_elements(&sc.faces, size);
+    let occ = Occluders::new(&sc.faces);
+    let direct: Vec<DVec3> = el.vertex_face.iter().map(|&f| direct(f)).collect();
+    let r = indirect(sc, &el, &direct, &occ, &Progress::new()).unwrap();
+    (el, r)
+}
+
 /// Form factor from a point at the origin (facing +z) to the rectangle `[x0, x1] × [y0, y1]`
 /// at height `h`, facing down: sums and differences of corner rectangles.
 fn rect_factor(x0: f64, x1: f64, y0: f64, y1: f64, h: f64) -> f64 {
@@ -99,10 +109,7 @@ fn step_emitter_a_few_mm_over_a_receiver() {
         DVec3::ZERO,
     );
     let sc = scene(vec![bright, dark, receiver], |s| s.convergence = 1e-4);
-    let el = sized_elements(&sc.faces, 0.01);
-    let occ = Occluders::new(&sc.faces);
-    let direct = vec![DVec3::ZERO; el.positions.len()];
-    let r = indirect(&sc, &el, &direct, &occ, &Progress::new()).unwrap();
+    let (el, r) = bake_sized(&sc, 0.01, |_| DVec3::ZERO);
     let nearest = |x: f64| {
         (0..el.positions.len())
             .filter(|&i| el.vertex_face[i] == 2)
@@ -159,10 +166,7 @@ fn box_side_beside_a_glowing_box_sees_its_face_not_a_cluster() {
         DVec3::splat(1e6),
     ));
     let sc = scene(faces, |s| s.convergence = 1e-3);
-    let el = sized_elements(&sc.faces, 0.02);
-    let occ = Occluders::new(&sc.faces);
-    let direct = vec![DVec3::ZERO; el.positions.len()];
-    let r = indirect(&sc, &el, &direct, &occ, &Progress::new()).unwrap();
+    let (el, r) = bake_sized(&sc, 0.02, |_| DVec3::ZERO);
     let mut checked = 0;
     for (i, p) in el.positions.iter().enumerate() {
         // The first box's side facing +x, inside its border.
@@ -232,10 +236,7 @@ fn faint_near_light_keeps_its_shape_for_the_next_bounce() {
         s.convergence = 1e-3;
         s.patch_size = 0.004;
     });
-    let el = sized_elements(&sc.faces, 0.004);
-    let occ = Occluders::new(&sc.faces);
-    let direct = vec![DVec3::ZERO; el.positions.len()];
-    let r = indirect(&sc, &el, &direct, &occ, &Progress::new()).unwrap();
+    let (el, r) = bake_sized(&sc, 0.004, |_| DVec3::ZERO);
     let step = 2.5e-4;
     let grid: Vec<(f64, f64, f64)> = (0..800)
         .flat_map(|i| {
@@ -309,14 +310,7 @@ fn narrow_gap_under_a_seat_stays_dark() {
         DVec3::ZERO,
     );
     let sc = scene(vec![floor, seat, leg], |s| s.convergence = 1e-3);
-    let el = sized_elements(&sc.faces, 0.01);
-    let occ = Occluders::new(&sc.faces);
-    let direct: Vec<DVec3> = el
-        .vertex_face
-        .iter()
-        .map(|&f| if f == 0 { DVec3::ONE } else { DVec3::ZERO })
-        .collect();
-    let r = indirect(&sc, &el, &direct, &occ, &Progress::new()).unwrap();
+    let (el, r) = bake_sized(&sc, 0.01, |f| if f == 0 { DVec3::ONE } else { DVec3::ZERO });
     let mean_on = |face: u32, keep: &dyn Fn(DVec3) -> bool| {
         let xs: Vec<f64> = (0..el.positions.len())
             .filter(|&i| el.vertex_face[i] == face && keep(el.positions[i]))
@@ -374,10 +368,7 @@ fn floor_under_a_table_sees_no_ceiling_through_it() {
         DVec3::ZERO,
     );
     let sc = scene(vec![ceiling, floor, top], |s| s.convergence = 1e-3);
-    let el = sized_elements(&sc.faces, 0.1);
-    let occ = Occluders::new(&sc.faces);
-    let direct = vec![DVec3::ZERO; el.positions.len()];
-    let r = indirect(&sc, &el, &direct, &occ, &Progress::new()).unwrap();
+    let (el, r) = bake_sized(&sc, 0.1, |_| DVec3::ZERO);
     let seen = |p: DVec3| {
         let ceiling = rect_factor(-2.0 - p.x, 2.0 - p.x, -2.0 - p.y, 2.0 - p.y, ceiling_h);
         // The top's corners seen from p, carried up to the ceiling's plane, clipped to it.
@@ -450,14 +441,7 @@ fn backrest_sees_the_floor_past_the_seat_edge() {
         DVec3::ZERO,
     );
     let sc = scene(vec![floor, seat, back], |s| s.convergence = 1e-3);
-    let el = sized_elements(&sc.faces, 0.02);
-    let occ = Occluders::new(&sc.faces);
-    let direct: Vec<DVec3> = el
-        .vertex_face
-        .iter()
-        .map(|&f| if f == 1 { DVec3::ZERO } else { DVec3::ONE })
-        .collect();
-    let r = indirect(&sc, &el, &direct, &occ, &Progress::new()).unwrap();
+    let (el, r) = bake_sized(&sc, 0.02, |f| if f == 1 { DVec3::ZERO } else { DVec3::ONE });
     let rect = |x0: f64, x1: f64, y0: f64, y1: f64| {
         [v(x0, y0, 0.), v(x1, y0, 0.), v(x1, y1, 0.), v(x0, y1, 0.)]
     };
@@ -517,20 +501,13 @@ fn shooter_in_shadow_sends_nothing_from_its_umbra() {
         DVec3::ZERO,
     ));
     let sc = scene(faces, |s| s.convergence = 1e-4);
-    let el = sized_elements(&sc.faces, 0.05);
-    let occ = Occluders::new(&sc.faces);
-    let direct: Vec<DVec3> = el
-        .vertex_face
-        .iter()
-        .map(|&f| {
-            if (1..5).contains(&f) {
-                DVec3::ONE
-            } else {
-                DVec3::ZERO
-            }
-        })
-        .collect();
-    let r = indirect(&sc, &el, &direct, &occ, &Progress::new()).unwrap();
+    let (el, r) = bake_sized(&sc, 0.05, |f| {
+        if (1..5).contains(&f) {
+            DVec3::ONE
+        } else {
+            DVec3::ZERO
+        }
+    });
     let i = (0..el.positions.len())
         .filter(|&i| el.vertex_face[i] == 5)
         .min_by(|&a, &b| {

@@ -222,8 +222,9 @@ impl<'a> Gather<'a> {
 /// A leaf's look at the links above it, as the final gather made it (`Gather::leaf`):
 /// the visibilities the leaf found in place of its unsure links' means (index among them,
 /// visibility, whether its rays found the source in part), and where it found some in
-/// part, its anchors' own for those. Points on the leaf take those interpolated
-/// (`Gather::looked`) without casting rays; a leaf with no look keeps its links' means.
+/// part, its anchors' own for those (as `offsets` makes them) and the slopes its rays
+/// showed. Points on the leaf take those interpolated (`Gather::looked`) without casting
+/// rays; a leaf with no look keeps its links' means.
 /// Kept from the gather itself: made again with its rays, they were 18 % of room-78's
 /// bake (perf samples).
 #[derive(Default)]
@@ -258,17 +259,12 @@ impl LeafLook {
             .filter_map(|(i, u)| Some((i as u32, u.slope?)))
             .collect();
         let anchors = if unsure.iter().any(|u| u.varies) {
-            anchors
-                .map(|(p, own)| {
-                    let varied = own
-                        .iter()
-                        .zip(unsure)
-                        .filter(|(_, u)| u.varies)
-                        .map(|(&o, _)| o)
-                        .collect();
-                    (p, varied)
-                })
-                .collect()
+            let varied: Vec<&Unsure> = unsure.iter().filter(|u| u.varies).collect();
+            let own = anchors.map(|(p, own)| {
+                let own = own.iter().zip(unsure).filter(|(_, u)| u.varies);
+                (p, own.map(|(&o, _)| o).collect())
+            });
+            offsets(&varied, own)
         } else {
             Vec::new()
         };
@@ -375,9 +371,8 @@ impl Gather<'_> {
             return e;
         }
         let mut own = vec![0.0; look.anchors[0].1.len()];
-        let from = look.anchors.iter().map(|(p, f)| (*p, &f[..]));
         let varied: Vec<&Unsure> = unsure.iter().filter(|u| u.varies).collect();
-        interpolated(&varied, q.p, from, &mut own);
+        interpolated(&varied, q.p, &look.anchors, &mut own);
         let varied = unsure.iter().zip(xs).filter(|(u, _)| u.varies);
         for ((u, x), o) in varied.zip(own) {
             e += x * (o - u.v);
@@ -425,26 +420,33 @@ impl Unsure {
     }
 }
 
-/// `own` at `at`: the visibility of each unsure link on its slope (`Unsure::base`), plus
-/// what the anchors' own `from` (position, one per link) differ from theirs, interpolated by
-/// inverse square distance. Where no link has a slope, that is the anchors' values
-/// interpolated.
-fn interpolated<'x>(
-    unsure: &[&Unsure],
-    at: DVec3,
-    from: impl Iterator<Item = (DVec3, &'x [f64])>,
-    own: &mut [f64],
-) {
-    if !unsure.iter().any(|u| u.slope.is_some()) {
-        return inverse_square(at, from, own);
+/// The anchors' own visibilities of `links` (position, one per link) as `interpolated`
+/// takes them: where a link has a slope, less what all the links' slopes give there
+/// (`Unsure::base`), so that the slopes, not the anchors, carry how the visibility runs
+/// across the leaf. Made once per leaf.
+fn offsets(
+    links: &[&Unsure],
+    anchors: impl Iterator<Item = (DVec3, Vec<f64>)>,
+) -> Vec<(DVec3, Vec<f64>)> {
+    if !links.iter().any(|u| u.slope.is_some()) {
+        return anchors.collect();
     }
-    let n = unsure.len();
-    let off: Vec<(DVec3, Vec<f64>)> = from
-        .map(|(p, f)| (p, (0..n).map(|i| f[i] - unsure[i].base(p)).collect()))
-        .collect();
-    inverse_square(at, off.iter().map(|(p, f)| (*p, &f[..])), own);
-    for (o, u) in own.iter_mut().zip(unsure) {
-        *o += u.base(at);
+    anchors
+        .map(|(p, mut f)| {
+            f.iter_mut().zip(links).for_each(|(x, u)| *x -= u.base(p));
+            (p, f)
+        })
+        .collect()
+}
+
+/// The visibilities of `links` at `at` (into `own`) that the anchors' `offsets` give:
+/// theirs interpolated by inverse square distance, on the links' slopes where any has one.
+fn interpolated(links: &[&Unsure], at: DVec3, offsets: &[(DVec3, Vec<f64>)], own: &mut [f64]) {
+    inverse_square(at, offsets.iter().map(|(p, f)| (*p, &f[..])), own);
+    if links.iter().any(|u| u.slope.is_some()) {
+        own.iter_mut()
+            .zip(links)
+            .for_each(|(x, u)| *x += u.base(at));
     }
 }
 
@@ -499,12 +501,13 @@ impl Gather<'_> {
         }
         let mut own = vec![0.0; unsure.len()];
         let links: Vec<&Unsure> = unsure.iter().collect();
+        let from = anchors.iter().zip(&seen).map(|(&j, f)| (pos[j], f.clone()));
+        let off = offsets(&links, from);
         for (i, &(_, v)) in verts.iter().enumerate() {
             if anchors.contains(&i) {
                 continue;
             }
-            let from = anchors.iter().zip(&seen).map(|(&j, f)| (pos[j], &f[..]));
-            interpolated(&links, pos[i], from, &mut own);
+            interpolated(&links, pos[i], &off, &mut own);
             (out[i].1, out[i].2) = self.between(v, leaf, chain, &unsure, &own);
         }
         self.rays.fetch_add(rays, Ordering::Relaxed);
