@@ -93,13 +93,9 @@ const CONFIRM_POWER: f64 = 16384.0;
 /// Points of a receiver at which the factor's spread over it is sampled.
 const VARY_POINTS: u32 = 6;
 /// Receivers over which a source's factor varies by more than this fraction of its value
-/// at the centroid are split, for links carrying over `eps / VARY_POWER`. At 64, data1 made
-/// 310k links, 102k of its splits for this; at 16, 261k, and the error from Cycles
-/// (`per_mesh.py`) fell on all five solver scenes: data1 0.490 → 0.438 %, cornell 0.857 →
-/// 0.828 %, chair 0.412 → 0.394 %, room-78 2.691 → 2.662 %, room-245 4.664 → 4.651 %
-/// (whose final gather then casts 25.1M rays, against 23.5M).
+/// at the centroid are split, for links carrying over `eps / VARY_POWER`.
 const VARY_REL: f64 = 0.1;
-const VARY_POWER: f64 = 16.0;
+const VARY_POWER: f64 = 64.0;
 /// Sources whose first radiosity varies by more than `VARY_REL` are split for links
 /// carrying over `eps / SOURCE_VARY_POWER` of that variation.
 const SOURCE_VARY_POWER: f64 = 64.0;
