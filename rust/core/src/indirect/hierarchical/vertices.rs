@@ -353,13 +353,23 @@ impl Gather<'_> {
             for &(i, slope) in &look.slopes {
                 unsure[i as usize].slope = Some(slope);
             }
-            q.map(|q| self.looked_at(look, chain, &unsure, q)).collect()
+            let varied: Vec<&Unsure> = unsure.iter().filter(|u| u.varies).collect();
+            q.map(|q| self.looked_at(look, chain, &unsure, &varied, q))
+                .collect()
         })
     }
 
     /// `looked` at one point `q` of the leaf of `look`, whose ancestors are `chain` and
-    /// unsure links `unsure`, with the look's visibilities.
-    fn looked_at(&self, look: &LeafLook, chain: &[u32], unsure: &[Unsure], q: &Point) -> DVec3 {
+    /// unsure links `unsure` (those whose source it saw in part, `varied`), with the look's
+    /// visibilities.
+    fn looked_at(
+        &self,
+        look: &LeafLook,
+        chain: &[u32],
+        unsure: &[Unsure],
+        varied: &[&Unsure],
+        q: &Point,
+    ) -> DVec3 {
         let mut xs = Vec::with_capacity(unsure.len());
         let mut e = self
             .gathered_at(q.p, q.n, chain, unsure, |_, x| {
@@ -371,8 +381,7 @@ impl Gather<'_> {
             return e;
         }
         let mut own = vec![0.0; look.anchors[0].1.len()];
-        let varied: Vec<&Unsure> = unsure.iter().filter(|u| u.varies).collect();
-        interpolated(&varied, q.p, &look.anchors, &mut own);
+        interpolated(varied, q.p, &look.anchors, &mut own);
         let varied = unsure.iter().zip(xs).filter(|(u, _)| u.varies);
         for ((u, x), o) in varied.zip(own) {
             e += x * (o - u.v);
