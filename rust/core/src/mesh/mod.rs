@@ -130,6 +130,7 @@ pub fn mesh_receiver(
             } else {
                 sizing.lit(p, reach, &seen)
             };
+            let s = rf.gap.map_or(s, |w| s.min(sizing.gap(w)));
             // Refinement finds what the corners need (and `corner_split` gives each
             // triangle there its own value): no grading towards them beforehand.
             if light.is_some() {

@@ -16,6 +16,10 @@ const PER_DISTANCE: f64 = 1.0 / 20.0;
 /// element count from 17k to 27k for no gain in error.)
 const LIT_FLOOR: f64 = 1.0 / 8.0;
 const PENUMBRA_FLOOR: f64 = 1.0 / 64.0;
+/// Elements across a narrow gap are at most this many times its width: the hierarchy's
+/// leaves there are that fine too (`hierarchy::GAP_WIDTHS`), and its vertices must show
+/// how the light fades from the gap's mouth.
+const GAP_WIDTHS: f64 = 4.0;
 
 /// A light as seen from one receiver: a ball that holds it.
 #[derive(Debug, Clone, Copy)]
@@ -106,6 +110,12 @@ impl Sizing {
         self.fine
             .min(self.lit(p, reach, seen))
             .max(self.coarse * PENUMBRA_FLOOR)
+    }
+
+    /// Element size across a narrow gap `w` wide (`shadows::gaps`): the light bounced into
+    /// it fades within a few widths of its mouth, whatever the light outside does.
+    pub fn gap(&self, w: f64) -> f64 {
+        (GAP_WIDTHS * w).clamp(self.coarse * PENUMBRA_FLOOR, self.coarse)
     }
 
     /// The receiver's frame.

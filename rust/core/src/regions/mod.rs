@@ -28,8 +28,9 @@ use arrangement::{Arrangement, Segment, BOUNDARY_TAG};
 pub struct Region {
     pub relations: Vec<Relation>,
     pub blockers: Vec<Vec<u32>>,
-    /// Across a narrow gap from another face (`shadows::gaps`).
-    pub gap: bool,
+    /// Across a narrow gap from another face (`shadows::gaps`): the gap's width (the
+    /// narrowest, where gaps overlap).
+    pub gap: Option<f64>,
 }
 
 /// The receiver split into faces, with the edges that the mesh must conform to.
@@ -68,7 +69,7 @@ struct Classifier {
     /// Parts of the receiver inside closed solids.
     inside: Vec<Vec<DVec2>>,
     exposure: Vec<Exposure>,
-    gap_parts: Vec<Vec<DVec2>>,
+    gap_parts: Vec<(Vec<DVec2>, f64)>,
 }
 
 impl Classifier {
@@ -76,7 +77,7 @@ impl Classifier {
         polys: Vec<ShadowPolygon>,
         inside: Vec<Vec<DVec2>>,
         exposure: Vec<Exposure>,
-        gap_parts: Vec<Vec<DVec2>>,
+        gap_parts: Vec<(Vec<DVec2>, f64)>,
     ) -> Self {
         let boxes: Vec<(DVec2, DVec2)> = polys.iter().map(|p| bounds(&p.poly)).collect();
         let grid = BoxGrid::new(&boxes);
@@ -100,7 +101,7 @@ impl Classifier {
             return Region {
                 relations: vec![Relation::Umbra; n],
                 blockers,
-                gap: false,
+                gap: None,
             };
         }
         for (l, e) in exposure.iter().enumerate() {
@@ -143,7 +144,12 @@ impl Classifier {
         Region {
             relations,
             blockers,
-            gap: self.gap_parts.iter().any(|p| inside_convex(p, q)),
+            gap: self
+                .gap_parts
+                .iter()
+                .filter(|(p, _)| inside_convex(p, q))
+                .map(|&(_, w)| w)
+                .reduce(f64::min),
         }
     }
 }
@@ -351,7 +357,7 @@ fn uniform_regions(r: &Face, sh: ReceiverShadows, tol: &Tolerances) -> ReceiverR
     let mut rf = Region {
         relations: vec![Relation::Lit; n],
         blockers: vec![Vec::new(); n],
-        gap: false,
+        gap: None,
     };
     for (l, e) in sh.exposure.iter().enumerate() {
         if *e == Exposure::Hidden {

@@ -51,5 +51,5 @@ pub struct ReceiverShadows {
     pub gaps: Vec<[DVec2; 2]>,
     /// The parts those outlines bound (convex, counter-clockwise): their elements are told
     /// apart (`Region::gap`), and refinement gives them links of their own.
-    pub gap_parts: Vec<Vec<DVec2>>,
+    pub gap_parts: Vec<(Vec<DVec2>, f64)>,
 }

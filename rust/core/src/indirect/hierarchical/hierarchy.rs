@@ -84,7 +84,19 @@ pub struct Hierarchy {
     pub first_back: u32,
     pub back_face: Vec<u32>,
     leaf_radius: f64,
+    /// Per region of the element mesh, the largest leaf radius: `leaf_radius`, or less
+    /// across a narrow gap (`GAP_WIDTHS`).
+    region_radius: Vec<f64>,
 }
+
+/// Leaves across a narrow gap (`Region::gap`) have a radius of at most this many times its
+/// width: the light bounced into a gap fades within a few widths of its mouth, and a leaf
+/// reaching deeper gave all of the part across the light at its mouth, which its face's own
+/// leaf size made one leaf (room-245: two boxes' sides 2 mm apart, Cycles 0.02 where we
+/// gave 0.65). With elements as fine (`mesh::sizing`) and links into a gap split
+/// (`refine`), room-245's error from Cycles (`per_mesh.py`) went 4.66 → 3.80 %, room-78's
+/// 2.69 → 2.37 %; at 4 widths (elements at 8), room-245 3.91 %.
+const GAP_WIDTHS: f64 = 2.0;
 
 /// One leaf before the tree is built.
 #[derive(Debug, Clone, Copy)]
@@ -161,8 +173,17 @@ impl Hierarchy {
                 ((lo + hi) * 0.5, g)
             })
             .collect();
+        let region_radius = el
+            .regions
+            .iter()
+            .map(|r| {
+                r.gap
+                    .map_or(leaf_radius, |w| leaf_radius.min(GAP_WIDTHS * w))
+            })
+            .collect();
         let mut h = Hierarchy {
             leaf_radius,
+            region_radius,
             first_back: first_back as u32,
             back_face: backs.to_vec(),
             ..Default::default()
@@ -228,7 +249,12 @@ impl Hierarchy {
         let (lo, hi) = bounds(leaves.iter().map(|l| l.centroid));
         // Centroid bounds understate the triangles' own by about a triangle: a leaf is
         // judged by its centroids' spread, which is what refinement can still tell apart.
-        if leaves.len() == 1 || 0.5 * (hi - lo).length() <= self.leaf_radius {
+        let radius = self
+            .region_radius
+            .get(leaves[0].region as usize)
+            .copied()
+            .unwrap_or(self.leaf_radius);
+        if leaves.len() == 1 || 0.5 * (hi - lo).length() <= radius {
             let pos = self.order.len() as u32;
             let area: f64 = leaves.iter().map(|l| l.area).sum();
             let centroid = leaves.iter().map(|l| l.centroid * l.area).sum::<DVec3>() / area;
