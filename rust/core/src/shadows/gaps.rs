@@ -149,7 +149,8 @@ mod test {
         let near = square(DVec3::new(0.9, 0.9, 0.002), hy, hx);
         assert!(near.plane.n.z < -0.99);
         let mut out = Vec::new();
-        across(&r, &near, &tol, &mut out);
+        let (_, width) = across(&r, &near, &tol, &mut out).expect("a narrow gap");
+        assert!((width - 0.002).abs() < 1e-12, "{width}");
         // The part across is [0.7, 1]², two of whose edges are the receiver's own.
         assert_eq!(out.len(), 2, "{out:?}");
         for [a, b] in &out {
