@@ -49,7 +49,9 @@ pub struct ReceiverShadows {
     /// Outlines of the parts across a narrow gap from another face (`gaps`), in its frame:
     /// region boundaries for bounced light, not discontinuities.
     pub gaps: Vec<[DVec2; 2]>,
-    /// The parts those outlines bound (convex, counter-clockwise): their elements are told
-    /// apart (`Region::gap`), and refinement gives them links of their own.
+    /// The parts those outlines bound (convex, counter-clockwise), each with the gap's width
+    /// (how far the facing face's farthest corner lies from the receiver's plane): their
+    /// elements are told apart (`Region::gap`), sized and grouped into leaves by that
+    /// width, and refinement gives them links of their own.
     pub gap_parts: Vec<(Vec<DVec2>, f64)>,
 }
