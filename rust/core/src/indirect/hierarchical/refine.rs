@@ -341,6 +341,8 @@ impl<'a> Refiner<'a> {
         // A shaft with something in it is treated as partly blocked without a ray: a few
         // rays can miss a small blocker near one end (a leg under a seat).
         let listed = blockers.as_ref().is_some_and(|l| !l.is_empty());
+        // Known to hold nothing: the shaft query found no face in it.
+        let clear = blockers.as_ref().is_some_and(|l| l.is_empty());
         if listed && !both_leaves && power > self.eps / PARTIAL && !self.over_budget() {
             let given = Given::new(blockers.as_deref(), given.hint, false);
             return self.split_larger(r, s, given, out);
@@ -392,7 +394,7 @@ impl<'a> Refiner<'a> {
         // leaves at `hierarchy::GAP_WIDTHS`: 0.31 of the light beside the slot deep in it
         // with rays in part only, 0.12 so; Cycles under 0.1).
         if v > 0.0
-            && (v < 1.0 || !blockers.as_ref().is_some_and(|l| l.is_empty()))
+            && (v < 1.0 || !clear)
             && self.mixed[r as usize]
             && power > self.eps / FAINT_SPLIT_POWER
             && !self.over_budget()
@@ -408,7 +410,7 @@ impl<'a> Refiner<'a> {
         }
         // Kept because its rays all passed: see the module doc (and why at least
         // `CONFIRM_RAYS`).
-        if v == 1.0 && cast > 0 && splits && !blockers.as_ref().is_some_and(|l| l.is_empty()) {
+        if v == 1.0 && cast > 0 && splits && !clear {
             let (open, more) = self.second_look(r, s, blockers.as_deref(), rays.max(CONFIRM_RAYS));
             v = open.unwrap_or(v);
             out.rays += more as u64;
@@ -420,7 +422,6 @@ impl<'a> Refiner<'a> {
             }
             return;
         }
-        let clear = blockers.as_ref().is_some_and(|l| l.is_empty());
         let factor = if faint { Factor::Near } else { Factor::Sampled };
         let link = ends.link(h, self.vis.el, r, s, v, clear, factor);
         self.push(out, link, &ends);
