@@ -95,7 +95,7 @@ pub struct Hierarchy {
 /// leaf size made one leaf (room-245: two boxes' sides 2 mm apart, Cycles 0.02 where we
 /// gave 0.65). With elements as fine (`mesh::sizing`) and links into a gap split
 /// (`refine`), room-245's error from Cycles (`per_mesh.py`) went 4.66 → 3.80 %, room-78's
-/// 2.69 → 2.37 %; at 4 widths (elements at 8), room-245 3.91 %.
+/// 2.69 → 2.36 %; at 4 widths (elements at 8), room-245 3.91 %.
 const GAP_WIDTHS: f64 = 2.0;
 
 /// One leaf before the tree is built.
