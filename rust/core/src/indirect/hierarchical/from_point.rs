@@ -9,8 +9,9 @@
 //! every point is uniform over the node's area, and the strata spread them over it. From a
 //! leaf, the start points are drawn the same way, their strata in another order.
 //!
-//! The estimate is the ratio of the point-to-point kernel `cosθ·cosθs / d²` over the open
-//! segments to the kernel over all of them. Where a segment is open depends on where the
+//! The estimate is the ratio of the point-to-point kernel `cosθ·cosθs / d²`, times how
+//! bright the segment's end on the source is (`Visibility::bright`), over the open segments
+//! to the same over all of them. Where a segment is open depends on where the
 //! blockers stand, its kernel on where its end is: with the points drawn independently of
 //! the blockers the ratio's expectation is the kernel-weighted visible fraction for any
 //! count, and where the two are correlated its bias is of the order of the weights' spread
@@ -251,14 +252,14 @@ pub fn seen_from(
         for (d, e) in draws[..m].iter().zip(ends.iter_mut()) {
             *e = segment_ends(vis, start, d);
         }
-        for &(p, n, y, ny) in &ends[..m] {
+        for (&(p, n, y, ny), draw) in ends[..m].iter().zip(&draws[..m]) {
             let d = y - p;
             let (ca, cb) = (n.dot(d), -ny.dot(d));
             if !(ca > 0.0 && cb > 0.0) {
                 continue;
             }
             let d2 = d.length_squared();
-            let w = ca * cb / (d2 * d2);
+            let w = ca * cb / (d2 * d2) * vis.bright(s, draw.end.0);
             if !w.is_finite() {
                 continue;
             }

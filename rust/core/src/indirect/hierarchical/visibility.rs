@@ -13,6 +13,10 @@ use crate::mesh::elements::Elements;
 use crate::scene::solids::{Occluder, Solid};
 use crate::scene::Face;
 
+/// The least weight `Visibility::bright` gives a point, against its source's mean: where
+/// the estimate says dark (no direct light), light still arrives by bounces.
+const BRIGHT_FLOOR: f64 = 0.05;
+
 /// Blocker lists longer than this go to the BVH per segment instead.
 pub const MAX_LISTED: usize = 32;
 /// Shaft tests give up (and rays go through the BVH) past this many candidate faces: for
@@ -214,7 +218,8 @@ impl Visibility<'_> {
         };
         // Each segment counts by its own point-to-point factor cosθ·cosθs / d²: the part
         // of a large source next to the receiver carries most of the light, and it is the
-        // part least often hidden (a floor beside a box among clutter).
+        // part least often hidden (a floor beside a box among clutter). And by how bright
+        // its source end is (`bright`).
         let soft = s.area / (std::f64::consts::PI * k as f64);
         let (mut open, mut total, mut counted) = (0.0f64, 0.0f64, 0u32);
         for i in 0..4 * k {
@@ -222,13 +227,13 @@ impl Visibility<'_> {
                 break;
             }
             let (a, na) = self.sample(r, i % k, k, i / k);
-            let (b, nb) = self.sample(s, (i * 5 + 1) % k, k, i / k);
+            let (b, nb, pos) = self.sample_at(s, (i * 5 + 1) % k, k, i / k);
             let d = b - a;
             let (ca, cb) = (na.dot(d), -nb.dot(d));
             if ca > 0.0 && cb > 0.0 {
                 counted += 1;
                 let d2 = d.length_squared();
-                let w = ca * cb / (d2 * (d2 + soft));
+                let w = ca * cb / (d2 * (d2 + soft)) * self.bright(s, pos);
                 total += w;
                 if !blocked(a, b) {
                     open += w;
@@ -263,6 +268,26 @@ impl Visibility<'_> {
     /// their leaf), with its face's normal: leaves spread over its range, and several points
     /// inside a leaf when there are fewer leaves than points.
     pub fn sample(&self, n: &Node, i: u32, k: u32, round: u32) -> (DVec3, DVec3) {
+        let (p, normal, _) = self.sample_at(n, i, k, round);
+        (p, normal)
+    }
+
+    /// How bright the leaf at position `pos` of source `n` is against `n` as a whole, by the
+    /// estimate `Hierarchy::weigh` made (1 where `n` has none): a segment's weight in a look
+    /// is the light it would carry. A link sends its source's mean radiosity times one
+    /// visibility, so that visibility must be the share of the light that passes, not of
+    /// the area: a box's lit top sees the ceiling whole, while its dark sides see little
+    /// of it past the boxes beside them.
+    pub fn bright(&self, n: &Node, pos: u32) -> f64 {
+        if !(n.weight > 0.0) {
+            return 1.0;
+        }
+        let leaf = &self.h.nodes[self.h.leaf_node[pos as usize] as usize];
+        (leaf.weight / n.weight).max(BRIGHT_FLOOR)
+    }
+
+    /// `sample`, with the leaf position the point lies on.
+    pub fn sample_at(&self, n: &Node, i: u32, k: u32, round: u32) -> (DVec3, DVec3, u32) {
         let count = n.hi - n.lo;
         let (leaf, j, m) = if count >= k {
             (
@@ -288,7 +313,7 @@ impl Visibility<'_> {
         }
         // The leaf's face, not the triangle's: a back leaf faces the other way.
         let normal = self.faces[face as usize].plane.n;
-        (a * (1.0 - u - v) + b * u + c * v, normal)
+        (a * (1.0 - u - v) + b * u + c * v, normal, leaf)
     }
 }
 
