@@ -21,7 +21,7 @@ sys.path.insert(0, os.path.dirname(HERE))
 import numpy as np  # noqa: E402
 
 from bench_lib import penumbra_job  # noqa: E402
-from bench_lib.main import ROOT  # noqa: E402
+from bench_lib.main import work_arg  # noqa: E402
 
 
 def polygon_area(poly):
@@ -30,11 +30,7 @@ def polygon_area(poly):
 
 
 def main(argv):
-    work = os.path.join(ROOT, "target", "bench-work")
-    if "--work" in argv:
-        i = argv.index("--work")
-        work = argv[i + 1]
-        argv = argv[:i] + argv[i + 2:]
+    work, argv = work_arg(argv)
     name, exe = argv[:2]
     extra = json.loads(argv[2]) if len(argv) > 2 else {}
     os.makedirs(work, exist_ok=True)

@@ -82,6 +82,15 @@ def machine():
                 commit=rev, date=time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()))
 
 
+def work_arg(argv):
+    """A bench helper's `--work DIR` (target/bench-work unless given), and its other
+    arguments."""
+    if "--work" in argv:
+        i = argv.index("--work")
+        return argv[i + 1], argv[:i] + argv[i + 2:]
+    return os.path.join(ROOT, "target", "bench-work"), argv
+
+
 def log(*a):
     print("bench:", *a, file=sys.stderr, flush=True)
 

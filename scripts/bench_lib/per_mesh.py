@@ -18,16 +18,12 @@ sys.path.insert(0, os.path.dirname(HERE))
 import numpy as np  # noqa: E402
 
 from bench_lib import errors, penumbra_job  # noqa: E402
-from bench_lib.main import ROOT, Config  # noqa: E402
+from bench_lib.main import Config, work_arg  # noqa: E402
 from bench_lib.reference import Reference  # noqa: E402
 
 
 def main(argv):
-    work = os.path.join(ROOT, "target", "bench-work")
-    if "--work" in argv:
-        i = argv.index("--work")
-        work = argv[i + 1]
-        argv = argv[:i] + argv[i + 2:]
+    work, argv = work_arg(argv)
     name, exe = argv[:2]
     extra = json.loads(argv[2]) if len(argv) > 2 else {}
     rf = Reference(name, "solvers", exe, sys.executable, work, Config(True))
