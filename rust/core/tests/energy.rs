@@ -87,15 +87,18 @@ fn absorbed_in(mut s: SceneJson) -> [f64; 3] {
             * 0.5;
         power += DVec3::from_array(l.radiance.expect("radiance")) * (std::f64::consts::PI * area);
     }
+    // Each polygon's albedo as the bake takes it (defaults included), from its faces.
+    let sc = penumbra::scene::validate(&s).expect("valid scene");
+    let albedo: std::collections::HashMap<(u32, u32), DVec3> = sc
+        .faces
+        .iter()
+        .map(|f| ((f.mesh, f.source_polygon), f.albedo))
+        .collect();
     let baked = bake(&s);
     let mut absorbed = DVec3::ZERO;
-    for (m, bm) in s.meshes.iter().zip(&baked.meshes) {
+    for (m, bm) in baked.meshes.iter().enumerate() {
         for (t, &poly) in bm.triangles.iter().zip(&bm.source_polygon) {
-            let rho = DVec3::from_array(match m.albedo.as_ref() {
-                Some(PerPolygon::Uniform(a)) => *a,
-                Some(PerPolygon::PerPolygon(a)) => a[poly as usize],
-                None => [0.8; 3],
-            });
+            let rho = albedo[&(m as u32, poly)];
             let e = t
                 .iter()
                 .map(|&v| DVec3::from_array(bm.colors[v as usize]))
