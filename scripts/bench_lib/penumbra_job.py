@@ -90,8 +90,12 @@ def colors_at(bake: dict, probe_mesh, probe_poly, probe_pos):
             pts = sel[probe_poly[sel] == poly]
             if len(tri_ids) == 0:
                 continue
+            # The tree over this polygon's own vertices only: the whole mesh's, converted
+            # for each polygon, took 171 of per_mesh.py's 238 s on room-245.
+            used, local = np.unique(T[tri_ids], return_inverse=True)
             tris = T[tri_ids]
-            tree = BVHTree.FromPolygons(P.tolist(), tris.tolist(), all_triangles=True)
+            tree = BVHTree.FromPolygons(P[used].tolist(), local.reshape(-1, 3).tolist(),
+                                        all_triangles=True)
             for k in pts:
                 loc, _, ti, _ = tree.find_nearest(Vector(probe_pos[k]))
                 if ti is None:
