@@ -196,6 +196,26 @@ pub fn subdivide(
         let u = v as usize;
         u < nv && gathered_on[u] == leaf && el.vertex_face[u] == face
     };
+    // What the rays of edge end `v` added to its value, given `g`, its value on `leaf` and
+    // `face` without them (smooth or by the leaf's look). An old vertex gathered on another
+    // leaf (where leaves meet) took its value from that leaf's links, so the difference from
+    // `g` would also carry how the two leaves' links disagree there, and a midpoint would
+    // take half of that: in a 7 mm slot between two boxes of room-245, a corner vertex
+    // gathered beside the slot's lit end (irradiance 8.5) lifted the midpoints of the leaf
+    // across the slot, which was 0.85 at Cycles' 0.43. For such an end, what its rays added
+    // on its own leaf; nothing where that leaf's means said too little to tell.
+    let own_rays = |v: u32, g: DVec3, leaf: u32, face: u32, out: &Subdivided| {
+        let u = v as usize;
+        if u >= nv || gathered_here(v, leaf, face) {
+            return out.indirect[u] - g;
+        }
+        let m = at_vertices.smooth[u];
+        if m.x.is_nan() {
+            DVec3::ZERO
+        } else {
+            out.indirect[u] - m
+        }
+    };
     let max_vertices = nv + MAX_ADDED_PER_VERTEX * nv;
     let key = |a: u32, b: u32| (a.min(b), a.max(b));
 
@@ -349,7 +369,8 @@ pub fn subdivide(
             err[i] = (m - 0.5 * (ga + gb)).abs().element_sum();
             // The smooth value's curve, plus what the ends' own rays added to theirs,
             // interpolated (as the mesh did before).
-            let own = (out.indirect[a as usize] - ga) + (out.indirect[b as usize] - gb);
+            let face = el.tri_face[origin[t as usize] as usize];
+            let own = own_rays(a, ga, leaf, face, out) + own_rays(b, gb, leaf, face, out);
             value[i] = m + 0.5 * own;
             judged[i] = Judged::Smooth(m);
         }
@@ -403,13 +424,14 @@ pub fn subdivide(
         let by_look: Vec<(usize, f64, DVec3, DVec3)> = looked
             .iter()
             .zip(at_mids)
-            .map(|(&(i, _), m)| {
+            .map(|(&(i, t), m)| {
                 let ((a, b), _) = todo[i];
                 let leaf = leaf_of[i];
                 let la = seen_ends[&(a, leaf)];
                 let lb = seen_ends[&(b, leaf)];
                 let err = (m - 0.5 * (la + lb)).abs().element_sum();
-                let own = (out.indirect[a as usize] - la) + (out.indirect[b as usize] - lb);
+                let face = el.tri_face[origin[t as usize] as usize];
+                let own = own_rays(a, la, leaf, face, out) + own_rays(b, lb, leaf, face, out);
                 (i, err, m + 0.5 * own, m)
             })
             .collect();
