@@ -80,12 +80,8 @@ fn absorbed_in(mut s: SceneJson) -> [f64; 3] {
             .iter()
             .map(|&x| DVec3::from_array(x))
             .collect();
-        let area = (1..p.len() - 1)
-            .map(|i| (p[i] - p[0]).cross(p[i + 1] - p[0]))
-            .sum::<DVec3>()
-            .length()
-            * 0.5;
-        power += DVec3::from_array(l.radiance.expect("radiance")) * (std::f64::consts::PI * area);
+        power +=
+            DVec3::from_array(l.radiance.expect("radiance")) * (std::f64::consts::PI * area3(&p));
     }
     // Each polygon's albedo as the bake takes it (defaults included), from its faces.
     let sc = penumbra::scene::validate(&s).expect("valid scene");
