@@ -23,7 +23,8 @@ pub struct Elements {
     pub tri_region: Vec<u32>,
     pub regions: Vec<Region>,
     /// Direct irradiance already computed at a vertex (by `mesh::refine`) with its light
-    /// counts (umbra, lit, penumbra), or `None`; empty when nothing was.
+    /// counts (umbra, lit, penumbra), or `None`; empty when nothing was, and once the
+    /// direct light is done (`bake::run` frees it).
     pub known_direct: Vec<Option<(DVec3, [u64; 3])>>,
 }
 

@@ -6,9 +6,9 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-/// Index i of the longest edge (tri[i], tri[i + 1]).
-pub(super) fn longest(pos: &[DVec3], tri: &[u32; 3]) -> usize {
-    let len = |i: usize| (pos[tri[i] as usize] - pos[tri[(i + 1) % 3] as usize]).length_squared();
+/// Index i of the longest edge (tri[i], tri[i + 1]), vertex positions by `pos`.
+pub(super) fn longest(pos: &impl Fn(u32) -> DVec3, tri: &[u32; 3]) -> usize {
+    let len = |i: usize| (pos(tri[i]) - pos(tri[(i + 1) % 3])).length_squared();
     let mut l = 0;
     for i in 1..3 {
         if len(i) > len(l) {
@@ -23,7 +23,7 @@ pub(super) fn longest(pos: &[DVec3], tri: &[u32; 3]) -> usize {
 /// the first `n` of the array and `n` (no allocation: every triangle of a pass goes
 /// through here).
 pub(super) fn bisect(
-    pos: &[DVec3],
+    pos: &impl Fn(u32) -> DVec3,
     tri: [u32; 3],
     mid: &impl Fn(u32, u32) -> Option<u32>,
 ) -> ([[u32; 3]; 4], usize) {
@@ -57,7 +57,7 @@ const CHUNK: usize = 4096;
 /// into its own lists, then laid end to end (a pass over room-245's 600k triangles took
 /// 0.04-0.07 s of one thread; a list of every triangle's four slots would hold 35 MB).
 pub(super) fn bisect_all(
-    pos: &[DVec3],
+    pos: &(impl Fn(u32) -> DVec3 + Sync),
     triangles: &[[u32; 3]],
     origin: &[u32],
     mid: &(impl Fn(u32, u32) -> Option<u32> + Sync),
@@ -140,7 +140,7 @@ mod test {
                 (1, 2) if with_bc => Some(5),
                 _ => None,
             };
-            let (parts, n) = bisect(&pos, [0, 1, 2], &mid);
+            let (parts, n) = bisect(&|v| pos[v as usize], [0, 1, 2], &mid);
             let parts = &parts[..n];
             assert_eq!(parts.len(), 2 + with_ca as usize + with_bc as usize);
             let sum: f64 = parts.iter().map(area).sum();

@@ -58,19 +58,19 @@ const FLOOR: f64 = 0.05;
 
 /// What the splits add to the element mesh: vertices after the old ones (same ids for
 /// those), with their direct light, and the whole new triangle list. The added vertices'
-/// attributes but their positions are kept apart from the old ones' (room-8328 has 5.8M
-/// vertices: a copy of each array is 20–140 MB).
+/// attributes are kept apart from the old ones' (room-8328 has 5.8M vertices: a copy of
+/// each array is 20–140 MB, and copies of the positions, the indirect light and the
+/// triangles' faces and regions were about 0.3 GB of its peak).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Subdivided {
-    /// Every vertex's, old and added.
-    pub positions: Vec<DVec3>,
     /// The added vertices'.
+    pub positions: Vec<DVec3>,
     pub eval: Vec<DVec3>,
     pub normals: Vec<DVec3>,
     pub vertex_face: Vec<u32>,
     /// Direct irradiance at the added vertices.
     pub direct: Vec<DVec3>,
-    /// Indirect irradiance at every vertex, old and added.
+    /// Indirect irradiance at the added vertices.
     pub indirect: Vec<DVec3>,
     pub triangles: Vec<[u32; 3]>,
     pub tri_face: Vec<u32>,
@@ -170,22 +170,25 @@ pub fn subdivide(
     let outlines = crate::direct::outlines(scene);
 
     let mut out = Subdivided {
-        positions: par_copy(&el.positions),
+        positions: Vec::new(),
         eval: Vec::new(),
         normals: Vec::new(),
         vertex_face: Vec::new(),
         direct: Vec::new(),
-        indirect: par_copy(indirect),
+        indirect: Vec::new(),
         triangles: par_copy(&el.triangles),
-        tri_face: par_copy(&el.tri_face),
-        tri_region: par_copy(&el.tri_region),
+        // Made from the triangles' origins at the end.
+        tri_face: Vec::new(),
+        tri_region: Vec::new(),
         passes: 0,
     };
     // Old vertices' attributes from `el` (and `direct`), added ones' from `out`.
+    let position_at = |out: &Subdivided, v: usize| either(&el.positions, &out.positions, nv, v);
     let eval_at = |out: &Subdivided, v: usize| either(&el.eval, &out.eval, nv, v);
     let normal_at = |out: &Subdivided, v: usize| either(&el.normals, &out.normals, nv, v);
     let face_at = |out: &Subdivided, v: usize| either(&el.vertex_face, &out.vertex_face, nv, v);
     let direct_at = |out: &Subdivided, v: usize| either(direct, &out.direct, nv, v);
+    let indirect_at = |out: &Subdivided, v: usize| either(indirect, &out.indirect, nv, v);
     // Triangles by origin: the element triangle each one came from.
     let mut origin: Vec<u32> = (0..el.triangles.len() as u32).collect();
     let mut known = Known::default();
@@ -207,13 +210,13 @@ pub fn subdivide(
     let own_rays = |v: u32, g: DVec3, leaf: u32, face: u32, out: &Subdivided| {
         let u = v as usize;
         if u >= nv || gathered_here(v, leaf, face) {
-            return out.indirect[u] - g;
+            return indirect_at(out, u) - g;
         }
         let m = at_vertices.smooth[u];
         if m.x.is_nan() {
             DVec3::ZERO
         } else {
-            out.indirect[u] - m
+            indirect[u] - m
         }
     };
     let max_vertices = nv + MAX_ADDED_PER_VERTEX * nv;
@@ -350,7 +353,7 @@ pub fn subdivide(
         // In no leaf (under a cover, buried), the interpolant, as its ends had.
         let mut value: Vec<DVec3> = todo
             .iter()
-            .map(|&((a, b), _)| 0.5 * (out.indirect[a as usize] + out.indirect[b as usize]))
+            .map(|&((a, b), _)| 0.5 * (indirect_at(out, a as usize) + indirect_at(out, b as usize)))
             .collect();
         let mut looked = Vec::new();
         for (&i, slot) in which.iter().zip(&slots) {
@@ -478,14 +481,13 @@ pub fn subdivide(
                         return None;
                     }
                     let (ua, ub) = (a as usize, b as usize);
-                    let pos = &out_ref.positions;
-                    if (pos[ua] - pos[ub]).length() < 2.0 * min_len {
+                    let (pa, pb) = (position_at(out_ref, ua), position_at(out_ref, ub));
+                    if (pa - pb).length() < 2.0 * min_len {
                         return None;
                     }
-                    let ind = &out_ref.indirect;
-                    let d = (ind[ua] - ind[ub]).abs().element_sum();
-                    let base =
-                        0.5 * (direct_at(out_ref, ua) + ind[ua] + direct_at(out_ref, ub) + ind[ub]);
+                    let (ia, ib) = (indirect_at(out_ref, ua), indirect_at(out_ref, ub));
+                    let d = (ia - ib).abs().element_sum();
+                    let base = 0.5 * (direct_at(out_ref, ua) + ia + direct_at(out_ref, ub) + ib);
                     (d > SCREEN * tol * (base.element_sum() + floor)).then_some((k, t as u32))
                 })
             })
@@ -501,7 +503,7 @@ pub fn subdivide(
             .filter(|&&(k, _)| {
                 let m = &known.mids[&k];
                 let (a, b) = (k.0 as usize, k.1 as usize);
-                let lin = 0.5 * (out.indirect[a] + out.indirect[b]);
+                let lin = 0.5 * (indirect_at(&out, a) + indirect_at(&out, b));
                 let k = match m.judged {
                     Judged::Smooth(_) => 1.0,
                     _ => LOOK_SCALE,
@@ -524,7 +526,7 @@ pub fn subdivide(
             for k in &frontier {
                 for &t in adj.of(*k) {
                     let tri = &out.triangles[t as usize];
-                    let l = longest(&out.positions, tri);
+                    let l = longest(&|v| position_at(&out, v as usize), tri);
                     let kl = key(tri[l], tri[(l + 1) % 3]);
                     if !marked.contains(&kl) {
                         more.push((kl, t));
@@ -544,15 +546,15 @@ pub fn subdivide(
                 frontier.push(k);
             }
         }
-        if out.positions.len() + split.len() > max_vertices {
+        if nv + out.positions.len() + split.len() > max_vertices {
             break;
         }
         split.par_sort_unstable();
         for k in &split {
             let m = known.mids.get_mut(k).expect("evaluated above");
-            m.vertex = out.positions.len() as u32;
+            m.vertex = (nv + out.positions.len()) as u32;
             let (a, b) = (k.0 as usize, k.1 as usize);
-            let p = (out.positions[a] + out.positions[b]) * 0.5;
+            let p = (position_at(&out, a) + position_at(&out, b)) * 0.5;
             let eval = (eval_at(&out, a) + eval_at(&out, b)) * 0.5;
             let (normal, face) = (normal_at(&out, a), face_at(&out, a));
             out.positions.push(p);
@@ -575,7 +577,8 @@ pub fn subdivide(
                 .map(|m| m.vertex)
                 .filter(|&v| v != NONE && marked.contains(&key(a, b)))
         };
-        let (tris, orig) = bisect_all(&out.positions, &out.triangles, &origin, &vertex_of);
+        let pos = |v: u32| position_at(&out, v as usize);
+        let (tris, orig) = bisect_all(&pos, &out.triangles, &origin, &vertex_of);
         out.triangles = tris;
         origin = orig;
         // Split edges are gone from the mesh: their midpoints are vertices now.
