@@ -229,9 +229,11 @@ impl<'a> Gather<'a> {
 /// bake (perf samples).
 #[derive(Default)]
 pub struct LeafLook {
-    changed: Vec<(u32, f64, bool)>,
+    /// Boxed, so without the slack of a vector grown by doubling: every leaf keeps its look
+    /// to the end of `subdivide`, where room-8328's memory peaks.
+    changed: Box<[(u32, f64, bool)]>,
     /// The slopes among them (`Unsure::slope`), apart: most changed links have none.
-    slopes: Vec<(u32, Slope)>,
+    slopes: Box<[(u32, Slope)]>,
     anchors: Vec<(DVec3, Vec<f64>)>,
     /// `Gather::partly_seen` of the leaf, where the look gathered at its centre (it does
     /// where a link's visibility is a mean).
@@ -247,17 +249,18 @@ impl LeafLook {
         partly: Option<bool>,
         anchors: impl Iterator<Item = (DVec3, Vec<f64>)>,
     ) -> Self {
+        // A look that kept its link's mean changes nothing for `looked`: not kept.
         let changed = unsure
             .iter()
             .enumerate()
-            .filter(|(_, u)| u.blockers.is_some())
+            .filter(|(_, u)| u.blockers.is_some() && (u.v != u.mean || u.varies))
             .map(|(i, u)| (i as u32, u.v, u.varies))
-            .collect();
+            .collect::<Box<_>>();
         let slopes = unsure
             .iter()
             .enumerate()
             .filter_map(|(i, u)| Some((i as u32, u.slope?)))
-            .collect();
+            .collect::<Box<_>>();
         let anchors = if unsure.iter().any(|u| u.varies) {
             let varied: Vec<&Unsure> = unsure.iter().filter(|u| u.varies).collect();
             let own = anchors.map(|(p, own)| {
@@ -347,10 +350,10 @@ impl Gather<'_> {
         self.leaf_by_leaf(points, DVec3::ZERO, |leaf, chain, q| {
             let look = looks.get(&leaf).unwrap_or(&none);
             let mut unsure = self.means(chain);
-            for &(i, v, varies) in &look.changed {
+            for &(i, v, varies) in look.changed.iter() {
                 (unsure[i as usize].v, unsure[i as usize].varies) = (v, varies);
             }
-            for &(i, slope) in &look.slopes {
+            for &(i, slope) in look.slopes.iter() {
                 unsure[i as usize].slope = Some(slope);
             }
             let varied: Vec<&Unsure> = unsure.iter().filter(|u| u.varies).collect();
