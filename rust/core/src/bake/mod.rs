@@ -14,7 +14,7 @@ use serde::Serialize;
 use crate::direct;
 use crate::geom::raycast::Occluders;
 use crate::indirect;
-use crate::mesh::elements::Elements;
+use crate::mesh::elements::{append, Elements};
 use crate::mesh::sizing::Sizing;
 use crate::mesh::{self, ReceiverMesh};
 use crate::regions::{self, ReceiverRegions, RegionTimes};
@@ -395,13 +395,6 @@ fn run(scene: &Scene, progress: &Progress) -> Result<Bake, BakeError> {
         stats,
         warnings: scene.warnings.clone(),
     })
-}
-
-/// `more` after `to`, in exactly the room they take: grown by doubling, room-8328's
-/// per-vertex arrays would each hold 11.7M slots for its 6.0M vertices.
-fn append<T>(to: &mut Vec<T>, more: Vec<T>) {
-    to.reserve_exact(more.len());
-    to.extend(more);
 }
 
 /// All receivers' meshes in one vertex/triangle space, in 3-D.

@@ -28,6 +28,14 @@ pub struct Elements {
     pub known_direct: Vec<Option<(DVec3, [u64; 3])>>,
 }
 
+/// `more` after the per-vertex array `to`, in exactly the room they take: grown by
+/// doubling, room-8328's per-vertex arrays would each hold 11.7M slots for its 6.0M
+/// vertices once `subdivide`'s are added.
+pub(crate) fn append<T>(to: &mut Vec<T>, more: Vec<T>) {
+    to.reserve_exact(more.len());
+    to.extend(more);
+}
+
 impl Elements {
     /// The triangle corners at each vertex, as (triangle, corner) in triangle order:
     /// `around[start[v]..start[v + 1]]`.

@@ -55,7 +55,7 @@ use visibility::Visibility;
 use crate::geom::box_grid::{bounds, BoxGrid};
 use crate::geom::polygon::strictly_inside_convex;
 use crate::geom::raycast::Occluders;
-use crate::mesh::elements::Elements;
+use crate::mesh::elements::{append, Elements};
 use crate::progress::Progress;
 use crate::scene::Scene;
 use crate::BakeError;
@@ -230,9 +230,7 @@ pub fn indirect(
     };
     let mut at = gathered.irradiance;
     if let Some(sub) = sub {
-        // Exactly: grown by doubling, room-8328's would hold 11.7M slots for 6.0M vertices.
-        at.reserve_exact(sub.indirect.len());
-        at.extend_from_slice(&sub.indirect);
+        append(&mut at, sub.indirect.clone());
         result.subdivided = Some(sub);
     }
     result.t_gather = t_gather.elapsed().as_secs_f64();
